@@ -1,0 +1,61 @@
+//! Errors of the compute layer.
+
+/// Errors raised while building or running a simulation.
+#[derive(Debug, thiserror::Error)]
+#[allow(missing_docs)] // fields are named after what they hold; variants are documented
+pub enum ComputeError {
+    /// A parameter has an invalid value.
+    #[error("invalid parameter {name} = {value}: {reason}")]
+    InvalidParameter { name: String, value: String, reason: String },
+    /// A time table is empty, unsorted or holds a non-finite value.
+    #[error("table {name}: {reason}")]
+    InvalidTable { name: String, reason: String },
+    /// A mesh-level error (selection, output).
+    #[error(transparent)]
+    Mesh(#[from] pcdc_mesh::MeshError),
+    /// Two physics declare the same field with different layouts.
+    #[error("field '{name}' declared twice with different layouts ({a} and {b})")]
+    FieldConflict { name: String, a: String, b: String },
+    /// A field was requested that no composed physics declared.
+    #[error("no field named '{0}' (declared fields: {1})")]
+    UnknownField(String, String),
+    /// The run diverged: NaN, infinity or runaway displacement.
+    #[error("divergence at step {step} (t = {time:e} s): {what} at {entity}. Hint: {hint}")]
+    Diverged { step: u64, time: f64, what: String, entity: String, hint: String },
+    /// No physics limits the time step and none was given.
+    #[error("no stable time step: no composed physics reports one; set it with SimulationBuilder::time_step")]
+    NoTimeStep,
+    /// Static relaxation did not converge.
+    #[error("static relaxation did not converge in {steps} steps (unbalanced-force ratio {ratio:e} > tolerance {tol:e}). Hint: raise max_steps or check that the model is fully supported")]
+    NotConverged { steps: u64, ratio: f64, tol: f64 },
+    /// A physics cannot take part in the direct (linear) static solve.
+    #[error("direct static solve unavailable: {0}")]
+    NotLinear(String),
+    /// The sparse factorisation failed (singular or indefinite stiffness).
+    #[error("sparse solve failed: {0}. Hint: the model may be under-constrained (rigid-body motion); add constraints")]
+    Solver(String),
+    /// A snapshot does not fit the simulation it is restored into.
+    #[error("snapshot mismatch: {0}")]
+    SnapshotMismatch(String),
+    /// An input/output error, with the path.
+    #[error("{path}: {source}")]
+    Io { path: String, #[source] source: std::io::Error },
+    /// Snapshot (de)serialisation failed.
+    #[error("snapshot encoding: {0}")]
+    Encoding(String),
+    /// A physics-specific error.
+    #[error("{physics}: {message}")]
+    Physics { physics: String, message: String },
+}
+
+impl ComputeError {
+    /// Shorthand for [`ComputeError::InvalidParameter`].
+    pub fn param(name: impl Into<String>, value: impl ToString, reason: impl Into<String>) -> Self {
+        ComputeError::InvalidParameter { name: name.into(), value: value.to_string(), reason: reason.into() }
+    }
+
+    /// Shorthand for [`ComputeError::Physics`].
+    pub fn physics(physics: impl Into<String>, message: impl Into<String>) -> Self {
+        ComputeError::Physics { physics: physics.into(), message: message.into() }
+    }
+}

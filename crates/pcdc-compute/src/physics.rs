@@ -1,0 +1,174 @@
+//! The `Physics` trait: one implementation per physics crate and backend.
+//!
+//! A physics declares the fields it needs, registers the node slots it writes forces
+//! into, contributes lumped mass and a stable time step, computes its forces each step,
+//! and may impose kinematic conditions on the integrated velocities. Everything that
+//! evolves in time lives in fields (so save/restore and device residency work); a
+//! physics struct holds only parameters and data derived once from the mesh.
+
+use pcdc_mesh::{Dim, Mesh};
+
+use crate::{Backend, ComputeError, CpuBackend, FieldSpec, FieldStore};
+
+/// Handle to a block of force slots registered by a physics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SlotBlock {
+    /// Index of the first slot in the physics' own slot buffer.
+    pub first: usize,
+    /// Number of slots.
+    pub len: usize,
+}
+
+/// What limits the stable time step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StableStep {
+    /// Critical time step of the limiting entity (s), before the safety factor.
+    pub dt: f64,
+    /// The limiting entity, e.g. "element 42".
+    pub entity: String,
+    /// Which physics reported it.
+    pub physics: String,
+}
+
+/// Read-only view of the kinematic state during a step.
+pub struct Kinematics<'a, D: Dim> {
+    /// The mesh (reference configuration).
+    pub mesh: &'a Mesh<D>,
+    /// Node displacement (m), stride D.
+    pub u: &'a [f64],
+    /// Node velocity (m/s), stride D (at the half step before the update in progress).
+    pub v: &'a [f64],
+    /// Current time (s).
+    pub time: f64,
+    /// Time step (s).
+    pub dt: f64,
+    /// Step counter.
+    pub step: u64,
+    /// Whether element viscous damping (manual eq. 17-19) is active (off during static
+    /// relaxation, which damps kinetically).
+    pub damping: bool,
+}
+
+impl<D: Dim> Kinematics<'_, D> {
+    /// Current position of node `n` component `k` (m).
+    #[inline]
+    pub fn x(&self, n: usize, k: usize) -> f64 {
+        self.mesh.coords()[n * D::D + k] + self.u[n * D::D + k]
+    }
+}
+
+/// Context given to [`Physics::init`].
+pub struct InitContext<'a, D: Dim> {
+    /// The mesh.
+    pub mesh: &'a Mesh<D>,
+    /// Field storage (already holding every declared field).
+    pub fields: &'a mut FieldStore,
+    pub(crate) slot_nodes: Vec<u32>,
+}
+
+impl<D: Dim> InitContext<'_, D> {
+    /// Registers force slots: slot `i` of the block adds its `D` components to node
+    /// `nodes[i]`. Nodes sum their slots in registration order (deterministic gather).
+    pub fn register_slots(&mut self, nodes: &[u32]) -> Result<SlotBlock, ComputeError> {
+        let n = self.mesh.n_nodes() as u32;
+        if let Some(&bad) = nodes.iter().find(|&&x| x >= n) {
+            return Err(ComputeError::param("slot node", bad, format!("mesh has {n} nodes")));
+        }
+        let first = self.slot_nodes.len();
+        self.slot_nodes.extend_from_slice(nodes);
+        Ok(SlotBlock { first, len: nodes.len() })
+    }
+}
+
+/// Context given to [`Physics::compute_forces`].
+pub struct ForceContext<'a, D: Dim, B: Backend> {
+    /// Kinematic state.
+    pub kin: Kinematics<'a, D>,
+    /// Field storage.
+    pub fields: &'a mut FieldStore,
+    /// This physics' force slots (stride D), to be overwritten (they start zeroed).
+    pub slots: &'a mut [f64],
+    /// The backend.
+    pub backend: &'a B,
+}
+
+/// Context given to [`Physics::apply_kinematics`] after the velocity update.
+pub struct VelocityContext<'a, D: Dim> {
+    /// The mesh.
+    pub mesh: &'a Mesh<D>,
+    /// Node displacement at the start of the step (m).
+    pub u: &'a [f64],
+    /// Node velocity just integrated (m/s): overwrite prescribed components here.
+    pub v: &'a mut [f64],
+    /// Time at the end of the step (s).
+    pub time: f64,
+    /// Time step (s).
+    pub dt: f64,
+    /// Field storage (e.g. for velocities integrated from prescribed accelerations).
+    pub fields: &'a mut FieldStore,
+}
+
+/// A linear constraint on one node's displacement used by the direct static solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DofConstraint {
+    /// Component `comp` of node `node` is held fixed.
+    Fixed {
+        /// Node index.
+        node: u32,
+        /// Component (0 = x, 1 = y, 2 = z).
+        comp: usize,
+    },
+    /// The node moves only along a direction or in a plane that is not axis-aligned.
+    Oblique {
+        /// Node index.
+        node: u32,
+    },
+}
+
+/// A physics on backend `B` in dimension `D`.
+pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
+    /// Name used in reports and errors.
+    fn name(&self) -> &str;
+
+    /// Fields this physics reads or writes (allocated before [`Physics::init`]).
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
+        Vec::new()
+    }
+
+    /// Validates the physics against the mesh, derives constant data, registers force
+    /// slots and sets initial field values.
+    fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError>;
+
+    /// Adds this physics' lumped nodal mass (kg) into `mass` (one value per node).
+    /// With `scale_to_dt = Some(dt)` the mass of each contributing entity is scaled up
+    /// where needed so that the entity is stable at `dt` (mass scaling for static
+    /// relaxation).
+    fn add_mass(&self, _mesh: &Mesh<D>, _fields: &FieldStore, _mass: &mut [f64], _scale_to_dt: Option<f64>) {}
+
+    /// The smallest critical time step of this physics' entities, with the entity.
+    fn stable_step(&self, _kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
+        None
+    }
+
+    /// Computes this physics' forces into its slots (and updates its fields).
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError>;
+
+    /// Imposes prescribed velocities, accelerations and constraints on the freshly
+    /// integrated velocities.
+    fn apply_kinematics(&self, _ctx: &mut VelocityContext<'_, D>) {}
+
+    /// Adds the linear (small-displacement) stiffness of this physics as triplets
+    /// `(row dof, col dof, value)`, dof = node * D + component, for the direct static
+    /// solve. `Ok(false)` means the physics has no stiffness; the default refuses.
+    fn linear_stiffness(&self, _mesh: &Mesh<D>, _fields: &FieldStore, _triplets: &mut Vec<(usize, usize, f64)>) -> Result<bool, ComputeError> {
+        Err(ComputeError::NotLinear(format!("physics '{}' has no linear stiffness", self.name())))
+    }
+
+    /// Kinematic constraints for the direct static solve.
+    fn dof_constraints(&self, _mesh: &Mesh<D>, _out: &mut Vec<DofConstraint>) {}
+
+    /// Energy stored by this physics (J), e.g. elastic strain energy; used by energy checks.
+    fn stored_energy(&self, _kin: &Kinematics<'_, D>, _fields: &FieldStore) -> f64 {
+        0.0
+    }
+}

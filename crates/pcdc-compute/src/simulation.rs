@@ -1,0 +1,543 @@
+//! The simulation: builder, explicit central-difference stepping, stable time step,
+//! divergence watchdog, energies and save/restore.
+//!
+//! One mechanical step (DESIGN.md): clear slots; every physics computes its forces into
+//! its own slots; each node sums its slots in a fixed order; central-difference update
+//! with lumped mass and gravity, `v += dt (F/m + g)` (manual 7.1 eq. iv); prescribed
+//! kinematics; `u += dt v` (eq. v); watchdog.
+
+use std::path::Path;
+
+use pcdc_mesh::{Dim, Mesh};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::physics::{ForceContext, InitContext, Kinematics, VelocityContext};
+use crate::{Backend, ComputeError, CpuBackend, FieldStore, Physics, StableStep};
+
+/// Default safety factor applied to the critical time step.
+pub const DEFAULT_SAFETY: f64 = 0.5;
+
+/// The evolving state: everything a snapshot must hold to continue a run bit for bit.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct State {
+    /// Time (s).
+    pub time: f64,
+    /// Completed steps.
+    pub step: u64,
+    /// Node displacement (m), stride D.
+    pub u: Vec<f64>,
+    /// Node velocity (m/s), stride D, at the half step `t - dt/2`.
+    pub v: Vec<f64>,
+    /// Fields declared by the composed physics.
+    pub fields: FieldStore,
+}
+
+/// Builds a [`Simulation`] from a mesh, a backend and the physics a scene composes.
+pub struct SimulationBuilder<D: Dim, B: Backend = CpuBackend> {
+    mesh: Mesh<D>,
+    backend: B,
+    physics: Vec<Box<dyn Physics<D, B>>>,
+    gravity: [f64; 3],
+    safety: f64,
+    fixed_dt: Option<f64>,
+    runaway: Option<f64>,
+    local_damping: f64,
+}
+
+impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
+    /// Starts a builder on `mesh` run by `backend`.
+    pub fn new(mesh: Mesh<D>, backend: B) -> Self {
+        SimulationBuilder { mesh, backend, physics: Vec::new(), gravity: [0.0; 3], safety: DEFAULT_SAFETY, fixed_dt: None, runaway: None, local_damping: 0.0 }
+    }
+
+    /// Adds a physics. Physics run in the order they are added (this fixes the
+    /// summation order of forces).
+    pub fn physics(mut self, p: impl Physics<D, B> + 'static) -> Self {
+        self.physics.push(Box::new(p));
+        self
+    }
+
+    /// Adds a boxed physics.
+    pub fn boxed_physics(mut self, p: Box<dyn Physics<D, B>>) -> Self {
+        self.physics.push(p);
+        self
+    }
+
+    /// Gravity acceleration (m/s²); only the first `D` components are used.
+    pub fn gravity(mut self, g: [f64; 3]) -> Self {
+        self.gravity = g;
+        self
+    }
+
+    /// Safety factor on the critical time step (0 < f <= 1, default 0.5).
+    pub fn safety_factor(mut self, f: f64) -> Self {
+        self.safety = f;
+        self
+    }
+
+    /// Uses a fixed time step (s) instead of the automatic stable one. A step above the
+    /// stable one is accepted but reported by [`Simulation::time_step_limit`].
+    pub fn time_step(mut self, dt: f64) -> Self {
+        self.fixed_dt = Some(dt);
+        self
+    }
+
+    /// Local non-viscous damping coefficient α (0 ≤ α < 1, default 0): each node force
+    /// component is reduced by `α |F| sign(v)` (Cundall's damping, as in PFC and
+    /// MatDEM), a quick way to reach a quasi-static state in a dynamic run.
+    pub fn local_damping(mut self, alpha: f64) -> Self {
+        self.local_damping = alpha;
+        self
+    }
+
+    /// Largest displacement (m) before the watchdog stops the run (default: 100 times
+    /// the model's bounding-box diagonal).
+    pub fn runaway_displacement(mut self, limit: f64) -> Self {
+        self.runaway = Some(limit);
+        self
+    }
+
+    /// Declares fields, initialises every physics, lumps masses and picks the time step.
+    pub fn build(self) -> Result<Simulation<D, B>, ComputeError> {
+        let SimulationBuilder { mesh, backend, mut physics, gravity, safety, fixed_dt, runaway, local_damping } = self;
+        if !(0.0..1.0).contains(&local_damping) {
+            return Err(ComputeError::param("local_damping", local_damping, "must lie in [0, 1)"));
+        }
+        if !(safety > 0.0 && safety <= 1.0) {
+            return Err(ComputeError::param("safety_factor", safety, "must lie in (0, 1]"));
+        }
+        if gravity.iter().any(|g| !g.is_finite()) {
+            return Err(ComputeError::param("gravity", format!("{gravity:?}"), "must be finite"));
+        }
+        if let Some(dt) = fixed_dt {
+            if !(dt > 0.0 && dt.is_finite()) {
+                return Err(ComputeError::param("time_step", dt, "must be positive and finite"));
+            }
+        }
+        let (lo, hi) = mesh.bounding_box();
+        let diag = lo.iter().zip(&hi).map(|(a, b)| (b - a).powi(2)).sum::<f64>().sqrt();
+        let runaway = runaway.unwrap_or(100.0 * diag);
+        if !(runaway > 0.0) {
+            return Err(ComputeError::param("runaway_displacement", runaway, "must be positive"));
+        }
+        let n_nodes = mesh.n_nodes();
+        let mut fields = FieldStore::default();
+        for p in &physics {
+            for spec in p.fields(&mesh) {
+                let count = match spec.location {
+                    crate::Location::Node => n_nodes,
+                    crate::Location::Element => mesh.n_elements(),
+                    crate::Location::Face => mesh.faces().len(),
+                };
+                fields.declare(spec, count)?;
+            }
+        }
+        let mut slot_ranges = Vec::with_capacity(physics.len());
+        let mut slot_nodes = Vec::new();
+        for p in physics.iter_mut() {
+            let mut ctx = InitContext { mesh: &mesh, fields: &mut fields, slot_nodes: Vec::new() };
+            p.init(&mut ctx)?;
+            let first = slot_nodes.len();
+            slot_nodes.extend_from_slice(&ctx.slot_nodes);
+            slot_ranges.push(first..slot_nodes.len());
+        }
+        // CSR node -> slots, slots in ascending (registration) order.
+        let mut gather_ptr = vec![0u32; n_nodes + 1];
+        for &n in &slot_nodes {
+            gather_ptr[n as usize + 1] += 1;
+        }
+        for i in 0..n_nodes {
+            gather_ptr[i + 1] += gather_ptr[i];
+        }
+        let mut fill = gather_ptr.clone();
+        let mut gather_idx = vec![0u32; slot_nodes.len()];
+        for (s, &n) in slot_nodes.iter().enumerate() {
+            gather_idx[fill[n as usize] as usize] = s as u32;
+            fill[n as usize] += 1;
+        }
+        let mut mass = vec![0.0; n_nodes];
+        for p in &physics {
+            p.add_mass(&mesh, &fields, &mut mass, None);
+        }
+        if let Some(n) = mass.iter().position(|&m| !(m > 0.0 && m.is_finite())) {
+            return Err(ComputeError::param(
+                format!("mass of node {n}"),
+                mass[n],
+                "every node needs a positive mass: compose a physics that gives the elements a density",
+            ));
+        }
+        let d = D::D;
+        let mut sim = Simulation {
+            state: State { time: 0.0, step: 0, u: vec![0.0; n_nodes * d], v: vec![0.0; n_nodes * d], fields },
+            mass_phys: mass.clone(),
+            mass,
+            force: vec![0.0; n_nodes * d],
+            slot_forces: vec![0.0; slot_nodes.len() * d],
+            slot_ranges,
+            gather_ptr,
+            gather_idx,
+            mesh,
+            backend,
+            physics,
+            gravity,
+            safety,
+            fixed_dt,
+            runaway,
+            dt: 0.0,
+            limit: None,
+            damping: true,
+            local_damping,
+        };
+        sim.update_time_step()?;
+        Ok(sim)
+    }
+}
+
+/// A running simulation.
+pub struct Simulation<D: Dim, B: Backend = CpuBackend> {
+    /// The evolving state.
+    pub state: State,
+    pub(crate) mesh: Mesh<D>,
+    pub(crate) backend: B,
+    pub(crate) physics: Vec<Box<dyn Physics<D, B>>>,
+    pub(crate) mass: Vec<f64>,
+    pub(crate) mass_phys: Vec<f64>,
+    pub(crate) force: Vec<f64>,
+    pub(crate) slot_forces: Vec<f64>,
+    pub(crate) slot_ranges: Vec<std::ops::Range<usize>>,
+    pub(crate) gather_ptr: Vec<u32>,
+    pub(crate) gather_idx: Vec<u32>,
+    pub(crate) gravity: [f64; 3],
+    pub(crate) safety: f64,
+    pub(crate) fixed_dt: Option<f64>,
+    pub(crate) runaway: f64,
+    pub(crate) dt: f64,
+    pub(crate) limit: Option<StableStep>,
+    pub(crate) damping: bool,
+    pub(crate) local_damping: f64,
+}
+
+/// Snapshot file header, checked on restore.
+#[derive(Serialize, Deserialize)]
+struct Snapshot {
+    magic: String,
+    dim: String,
+    n_nodes: usize,
+    n_elements: usize,
+    physics: Vec<String>,
+    dt: f64,
+    state: State,
+}
+
+const SNAPSHOT_MAGIC: &str = "pcdc-snapshot-1";
+
+impl<D: Dim> Simulation<D, CpuBackend> {
+    /// Starts a builder on the CPU backend.
+    pub fn builder(mesh: Mesh<D>, backend: CpuBackend) -> SimulationBuilder<D, CpuBackend> {
+        SimulationBuilder::new(mesh, backend)
+    }
+
+    /// Advances one explicit step.
+    pub fn step(&mut self) -> Result<(), ComputeError> {
+        self.compute_forces(false)?;
+        self.integrate()
+    }
+
+    /// Advances `n` steps.
+    pub fn run(&mut self, n: u64) -> Result<(), ComputeError> {
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// Advances until `time` (s) is reached (the last step may overshoot by < dt).
+    pub fn run_until(&mut self, time: f64) -> Result<(), ComputeError> {
+        while self.state.time < time {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// Evaluates every physics' forces at the current state without advancing, and
+    /// returns the net node force (N, stride D): applied loads minus internal forces.
+    /// At constrained nodes this includes the reaction.
+    pub fn evaluate_forces(&mut self) -> Result<&[f64], ComputeError> {
+        self.compute_forces(false)?;
+        Ok(&self.force)
+    }
+
+    /// Evaluates all forces at the current state and gathers them into the node force
+    /// (`gross = true` also returns the sum of absolute slot contributions per dof).
+    pub(crate) fn compute_forces(&mut self, gross: bool) -> Result<Option<Vec<f64>>, ComputeError> {
+        let d = D::D;
+        let kin_u = &self.state.u;
+        let kin_v = &self.state.v;
+        let fields = &mut self.state.fields;
+        self.slot_forces.fill(0.0);
+        for (p, r) in self.physics.iter().zip(&self.slot_ranges) {
+            let mut ctx = ForceContext {
+                kin: Kinematics { mesh: &self.mesh, u: kin_u, v: kin_v, time: self.state.time, dt: self.dt, step: self.state.step, damping: self.damping },
+                fields,
+                slots: &mut self.slot_forces[r.start * d..r.end * d],
+                backend: &self.backend,
+            };
+            p.compute_forces(&mut ctx)?;
+        }
+        let (ptr, idx, slots) = (&self.gather_ptr, &self.gather_idx, &self.slot_forces);
+        let force = &mut self.force;
+        self.backend.install(|| {
+            force.par_chunks_mut(d).enumerate().with_min_len(1024).for_each(|(n, f)| {
+                f.fill(0.0);
+                for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
+                    for k in 0..d {
+                        f[k] += slots[s as usize * d + k];
+                    }
+                }
+            })
+        });
+        if !gross {
+            return Ok(None);
+        }
+        let mut g = vec![0.0; force.len()];
+        for n in 0..self.mesh.n_nodes() {
+            for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
+                for k in 0..d {
+                    g[n * d + k] += slots[s as usize * d + k].abs();
+                }
+            }
+        }
+        Ok(Some(g))
+    }
+
+    /// Central-difference update from the gathered force, kinematic conditions, position
+    /// update and watchdog.
+    pub(crate) fn integrate(&mut self) -> Result<(), ComputeError> {
+        let d = D::D;
+        let dt = self.dt;
+        let g = self.gravity;
+        let alpha = self.local_damping;
+        let (force, mass, mass_phys) = (&self.force, &self.mass, &self.mass_phys);
+        let v = &mut self.state.v;
+        self.backend.install(|| {
+            v.par_chunks_mut(d).enumerate().with_min_len(1024).for_each(|(n, vn)| {
+                let (m, w) = (mass[n], mass_phys[n] / mass[n]);
+                for k in 0..d {
+                    let mut f = force[n * d + k] + w * m * g[k];
+                    if alpha > 0.0 {
+                        // Local non-viscous damping (Cundall): f -= α |f| sign(v).
+                        f -= alpha * f.abs() * vn[k].signum() * (vn[k] != 0.0) as u8 as f64;
+                    }
+                    vn[k] += dt * f / m;
+                }
+            })
+        });
+        let t_end = self.state.time + dt;
+        for p in &self.physics {
+            let mut ctx = VelocityContext { mesh: &self.mesh, u: &self.state.u, v: &mut self.state.v, time: t_end, dt, fields: &mut self.state.fields };
+            p.apply_kinematics(&mut ctx);
+        }
+        let limit2 = self.runaway * self.runaway;
+        let (u, v) = (&mut self.state.u, &self.state.v);
+        let bad = self.backend.install(|| {
+            u.par_chunks_mut(d)
+                .zip(v.par_chunks(d))
+                .enumerate()
+                .with_min_len(1024)
+                .filter_map(|(n, (un, vn))| {
+                    let mut u2 = 0.0;
+                    let mut finite = true;
+                    for k in 0..d {
+                        un[k] += dt * vn[k];
+                        u2 += un[k] * un[k];
+                        finite &= un[k].is_finite() && vn[k].is_finite();
+                    }
+                    if !finite {
+                        Some((n, true))
+                    } else if u2 > limit2 {
+                        Some((n, false))
+                    } else {
+                        None
+                    }
+                })
+                .min_by_key(|&(n, _)| n)
+        });
+        self.state.time = t_end;
+        self.state.step += 1;
+        if let Some((n, nonfinite)) = bad {
+            let hint = match &self.limit {
+                Some(l) => format!(
+                    "time step {:e} s (limit set by {} of {}); check that the time step is not above the stable one, that penalties are not extreme, and that loads and boundary conditions are sensible",
+                    self.dt, l.entity, l.physics
+                ),
+                None => "check the time step and the boundary conditions".to_string(),
+            };
+            let what = if nonfinite {
+                "non-finite (NaN or infinite) velocity or displacement".to_string()
+            } else {
+                format!("runaway displacement above {:e} m", self.runaway)
+            };
+            return Err(ComputeError::Diverged { step: self.state.step, time: self.state.time, what, entity: format!("node {n}"), hint });
+        }
+        Ok(())
+    }
+
+    /// Saves the running state to a file (postcard binary); see [`Simulation::restore`].
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), ComputeError> {
+        let path = path.as_ref();
+        let bytes = self.snapshot_bytes()?;
+        std::fs::write(path, bytes).map_err(|source| ComputeError::Io { path: path.display().to_string(), source })
+    }
+
+    /// Encodes the running state.
+    pub fn snapshot_bytes(&self) -> Result<Vec<u8>, ComputeError> {
+        let snap = Snapshot {
+            magic: SNAPSHOT_MAGIC.to_string(),
+            dim: D::NAME.to_string(),
+            n_nodes: self.mesh.n_nodes(),
+            n_elements: self.mesh.n_elements(),
+            physics: self.physics.iter().map(|p| p.name().to_string()).collect(),
+            dt: self.dt,
+            state: self.state.clone(),
+        };
+        postcard::to_stdvec(&snap).map_err(|e| ComputeError::Encoding(e.to_string()))
+    }
+
+    /// Restores a state saved by [`Simulation::save`] into a simulation built from the
+    /// same scene (same mesh and physics); continuing then equals the uninterrupted run
+    /// bit for bit.
+    pub fn restore(&mut self, path: impl AsRef<Path>) -> Result<(), ComputeError> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(|source| ComputeError::Io { path: path.display().to_string(), source })?;
+        self.restore_bytes(&bytes)
+    }
+
+    /// Restores from bytes made by [`Simulation::snapshot_bytes`].
+    pub fn restore_bytes(&mut self, bytes: &[u8]) -> Result<(), ComputeError> {
+        let snap: Snapshot = postcard::from_bytes(bytes).map_err(|e| ComputeError::Encoding(e.to_string()))?;
+        let mismatch = |what: String| Err(ComputeError::SnapshotMismatch(what));
+        if snap.magic != SNAPSHOT_MAGIC {
+            return mismatch(format!("not a pcdc snapshot (header '{}')", snap.magic));
+        }
+        if snap.dim != D::NAME || snap.n_nodes != self.mesh.n_nodes() || snap.n_elements != self.mesh.n_elements() {
+            return mismatch(format!(
+                "snapshot is {} with {} nodes and {} elements; simulation is {} with {} nodes and {} elements",
+                snap.dim, snap.n_nodes, snap.n_elements, D::NAME, self.mesh.n_nodes(), self.mesh.n_elements()
+            ));
+        }
+        let names: Vec<String> = self.physics.iter().map(|p| p.name().to_string()).collect();
+        if snap.physics != names {
+            return mismatch(format!("snapshot physics {:?}, simulation physics {:?}", snap.physics, names));
+        }
+        if snap.state.fields.specs() != self.state.fields.specs() {
+            return mismatch("field layouts differ".to_string());
+        }
+        self.state = snap.state;
+        self.dt = snap.dt;
+        Ok(())
+    }
+}
+
+impl<D: Dim, B: Backend> Simulation<D, B> {
+    /// The mesh.
+    pub fn mesh(&self) -> &Mesh<D> {
+        &self.mesh
+    }
+
+    /// The backend.
+    pub fn backend(&self) -> &B {
+        &self.backend
+    }
+
+    /// Current time step (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The entity that limits the stable time step, if any physics reported one.
+    pub fn time_step_limit(&self) -> Option<&StableStep> {
+        self.limit.as_ref()
+    }
+
+    /// Sets the local non-viscous damping coefficient α (see
+    /// [`SimulationBuilder::local_damping`]).
+    pub fn set_local_damping(&mut self, alpha: f64) -> Result<(), ComputeError> {
+        if !(0.0..1.0).contains(&alpha) {
+            return Err(ComputeError::param("local_damping", alpha, "must lie in [0, 1)"));
+        }
+        self.local_damping = alpha;
+        Ok(())
+    }
+
+    /// Turns element viscous damping (manual eq. 17-19) on or off for subsequent steps.
+    pub fn set_damping(&mut self, on: bool) {
+        self.damping = on;
+    }
+
+    /// Recomputes the stable time step from the current state (e.g. after large
+    /// deformation) unless a fixed step was set.
+    pub fn update_time_step(&mut self) -> Result<(), ComputeError> {
+        let kin = Kinematics { mesh: &self.mesh, u: &self.state.u, v: &self.state.v, time: self.state.time, dt: self.dt, step: self.state.step, damping: self.damping };
+        let mut best: Option<StableStep> = None;
+        for p in &self.physics {
+            if let Some(s) = p.stable_step(&kin, &self.state.fields) {
+                if best.as_ref().is_none_or(|b| s.dt < b.dt) {
+                    best = Some(s);
+                }
+            }
+        }
+        self.limit = best;
+        self.dt = match (self.fixed_dt, &self.limit) {
+            (Some(dt), _) => dt,
+            (None, Some(l)) => l.dt * self.safety,
+            (None, None) => return Err(ComputeError::NoTimeStep),
+        };
+        Ok(())
+    }
+
+    /// Lumped nodal mass (kg), one value per node.
+    pub fn mass(&self) -> &[f64] {
+        &self.mass
+    }
+
+    /// Node force gathered at the last step (N), stride D.
+    pub fn node_force(&self) -> &[f64] {
+        &self.force
+    }
+
+    /// Kinetic energy ½ Σ m v² (J) with the half-step velocities.
+    pub fn kinetic_energy(&self) -> f64 {
+        let d = D::D;
+        0.5 * self.state.v.chunks_exact(d).zip(&self.mass_phys).map(|(v, m)| m * v.iter().map(|x| x * x).sum::<f64>()).sum::<f64>()
+    }
+
+    /// Energy stored by all physics (J), e.g. elastic strain energy.
+    pub fn stored_energy(&self) -> f64 {
+        let kin = Kinematics { mesh: &self.mesh, u: &self.state.u, v: &self.state.v, time: self.state.time, dt: self.dt, step: self.state.step, damping: self.damping };
+        self.physics.iter().map(|p| p.stored_energy(&kin, &self.state.fields)).sum()
+    }
+
+    /// Current position of every node (m), stride D.
+    pub fn positions(&self) -> Vec<f64> {
+        self.mesh.coords().iter().zip(&self.state.u).map(|(x, u)| x + u).collect()
+    }
+
+    /// Values of a field by name.
+    pub fn field(&self, name: &str) -> Result<&[f64], ComputeError> {
+        let id = self.state.fields.id(name)?;
+        Ok(self.state.fields.get(id))
+    }
+
+    /// Names of the composed physics, in order.
+    pub fn physics_names(&self) -> Vec<String> {
+        self.physics.iter().map(|p| p.name().to_string()).collect()
+    }
+
+    /// Bytes held by the state, masses and force slots (memory footprint of the run).
+    pub fn state_bytes(&self) -> usize {
+        8 * (self.state.u.len() + self.state.v.len() + self.mass.len() * 2 + self.force.len() + self.slot_forces.len())
+            + 4 * (self.gather_idx.len() + self.gather_ptr.len())
+            + self.state.fields.bytes()
+    }
+}

@@ -1,0 +1,133 @@
+//! Time tables: piecewise-linear functions of time, wherever the manual marks a value
+//! `<table>` (boundary velocities, forces, stresses, ...).
+
+use serde::{Deserialize, Serialize};
+
+use crate::ComputeError;
+
+/// A piecewise-linear table `value(t)` through sorted points; constant beyond its ends.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Table {
+    t: Vec<f64>,
+    v: Vec<f64>,
+}
+
+impl Table {
+    /// Builds a table from `(time [s], value)` points. Errors on an empty table, a
+    /// non-finite entry, or times that are not strictly increasing (naming the entry).
+    pub fn new(name: &str, points: &[(f64, f64)]) -> Result<Self, ComputeError> {
+        let err = |reason: String| ComputeError::InvalidTable { name: name.to_string(), reason };
+        if points.is_empty() {
+            return Err(err("empty table: give at least one (time, value) point".into()));
+        }
+        for (i, &(t, v)) in points.iter().enumerate() {
+            if !t.is_finite() || !v.is_finite() {
+                return Err(err(format!("entry {i} ({t}, {v}) is not finite")));
+            }
+            if i > 0 && t <= points[i - 1].0 {
+                return Err(err(format!(
+                    "times must increase strictly: entry {i} has t = {t} after t = {}",
+                    points[i - 1].0
+                )));
+            }
+        }
+        Ok(Table { t: points.iter().map(|p| p.0).collect(), v: points.iter().map(|p| p.1).collect() })
+    }
+
+    /// Value at time `t` (s): linear between points, constant outside.
+    pub fn eval(&self, t: f64) -> f64 {
+        let n = self.t.len();
+        if t <= self.t[0] {
+            return self.v[0];
+        }
+        if t >= self.t[n - 1] {
+            return self.v[n - 1];
+        }
+        let i = self.t.partition_point(|&ti| ti <= t); // t[i-1] <= t < t[i]
+        let (t0, t1, v0, v1) = (self.t[i - 1], self.t[i], self.v[i - 1], self.v[i]);
+        v0 + (v1 - v0) * (t - t0) / (t1 - t0)
+    }
+
+    /// The table's points.
+    pub fn points(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.t.iter().copied().zip(self.v.iter().copied())
+    }
+}
+
+/// A value that is either constant or a time table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum TimeValue {
+    /// A constant.
+    Const(f64),
+    /// A piecewise-linear table of time.
+    Table(Table),
+}
+
+impl TimeValue {
+    /// Value at time `t` (s).
+    pub fn at(&self, t: f64) -> f64 {
+        match self {
+            TimeValue::Const(c) => *c,
+            TimeValue::Table(tab) => tab.eval(t),
+        }
+    }
+
+    /// Errors when a constant is not finite.
+    pub fn check(&self, name: &str) -> Result<(), ComputeError> {
+        match self {
+            TimeValue::Const(c) if !c.is_finite() => Err(ComputeError::param(name, c, "must be finite")),
+            _ => Ok(()),
+        }
+    }
+}
+
+impl From<f64> for TimeValue {
+    fn from(v: f64) -> Self {
+        TimeValue::Const(v)
+    }
+}
+
+impl From<Table> for TimeValue {
+    fn from(t: Table) -> Self {
+        TimeValue::Table(t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn errors() {
+        assert!(matches!(Table::new("v", &[]), Err(ComputeError::InvalidTable { .. })));
+        let e = Table::new("vel", &[(0.0, 1.0), (2.0, 1.0), (1.0, 0.0)]).unwrap_err();
+        assert!(e.to_string().contains("entry 2"), "{e}");
+        assert!(Table::new("v", &[(0.0, f64::NAN)]).is_err());
+        assert!(Table::new("v", &[(0.0, 1.0), (0.0, 2.0)]).is_err());
+    }
+
+    #[test]
+    fn interpolates_and_clamps() {
+        let t = Table::new("v", &[(0.0, 0.0), (1.0, 2.0), (3.0, 2.0)]).unwrap();
+        assert_eq!(t.eval(-1.0), 0.0);
+        assert_eq!(t.eval(0.5), 1.0);
+        assert_eq!(t.eval(2.0), 2.0);
+        assert_eq!(t.eval(9.0), 2.0);
+    }
+
+    proptest! {
+        #[test]
+        fn stays_within_bounds(vals in proptest::collection::vec(-1e3f64..1e3, 1..8), t in -1.0f64..10.0) {
+            let pts: Vec<(f64, f64)> = vals.iter().enumerate().map(|(i, &v)| (i as f64, v)).collect();
+            let tab = Table::new("p", &pts).unwrap();
+            let y = tab.eval(t);
+            let lo = vals.iter().cloned().fold(f64::INFINITY, f64::min);
+            let hi = vals.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            prop_assert!(y >= lo - 1e-9 && y <= hi + 1e-9);
+            for (i, &v) in vals.iter().enumerate() {
+                prop_assert_eq!(tab.eval(i as f64), v);
+            }
+        }
+    }
+}

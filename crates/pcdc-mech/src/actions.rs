@@ -1,0 +1,67 @@
+//! Resets between stages (manual 7.2.8): node velocity, node displacement and element
+//! state. Also used to give nodes an initial velocity.
+
+use pcdc_compute::{names, CpuBackend, Simulation};
+use pcdc_mesh::{Dim, Range};
+
+use crate::MechError;
+
+/// Name of the node field that stores the displacement at the last reset.
+pub const DISPLACEMENT_RESET: &str = "displacement_reset";
+
+/// Sets the velocity (m/s) of every node in `range` (first `D` components used).
+pub fn set_velocity<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &Range, velocity: [f64; 3]) -> Result<usize, MechError> {
+    if velocity.iter().any(|v| !v.is_finite()) {
+        return Err(MechError::param("velocity", format!("{velocity:?}"), "must be finite"));
+    }
+    let nodes = sim.mesh().select_nodes(range)?;
+    let d = D::D;
+    for &n in &nodes {
+        sim.state.v[n as usize * d..(n as usize + 1) * d].copy_from_slice(&velocity[..d]);
+    }
+    Ok(nodes.len())
+}
+
+/// Zeroes the velocity of every node in `range`.
+pub fn reset_velocity<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &Range) -> Result<usize, MechError> {
+    set_velocity(sim, range, [0.0; 3])
+}
+
+/// Resets the reported displacement of the nodes in `range` to zero without moving them:
+/// the current displacement is remembered in the `displacement_reset` field (declared by
+/// [`crate::Mechanics`]) and subtracted by [`crate::output::displacement`].
+pub fn reset_displacement<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &Range) -> Result<usize, MechError> {
+    let nodes = sim.mesh().select_nodes(range)?;
+    let id = sim.state.fields.id(DISPLACEMENT_RESET)?;
+    let d = D::D;
+    let u = sim.state.u.clone();
+    let off = sim.state.fields.get_mut(id);
+    for &n in &nodes {
+        let i = n as usize * d;
+        off[i..i + d].copy_from_slice(&u[i..i + d]);
+    }
+    Ok(nodes.len())
+}
+
+/// Resets the stress and the constitutive history variables of the elements in `range`
+/// to zero (the current shape becomes stress-free).
+pub fn reset_element_state<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &Range) -> Result<usize, MechError> {
+    let elems = sim.mesh().select_elements(range)?;
+    let fields = &mut sim.state.fields;
+    let stress = fields.id(names::STRESS)?;
+    let state = fields.id(names::MODEL_STATE)?;
+    let ns = fields.spec(state).components;
+    let nsym = D::NSYM;
+    for &e in &elems {
+        let e = e as usize;
+        fields.get_mut(stress)[e * nsym..(e + 1) * nsym].fill(0.0);
+        fields.get_mut(state)[e * ns..(e + 1) * ns].fill(0.0);
+    }
+    if D::D == 2 {
+        let zz = fields.id(names::STRESS_ZZ)?;
+        for &e in &elems {
+            fields.get_mut(zz)[e as usize] = 0.0;
+        }
+    }
+    Ok(elems.len())
+}

@@ -1,0 +1,40 @@
+//! # pcdc-mech
+//!
+//! Element mechanics for the pcdc-rs FDEM SDK (manual 7.2): the [`Mechanics`] physics
+//! (constant-strain Tri3/Tet4 with objective co-rotated kinematics, viscous damping
+//! eq. 17-19, lumped mass eq. 16), the [`ConstitutiveModel`] plugin trait with
+//! [`LinearElastic`] (eq. 20-24), the mechanical [`Boundary`] conditions of 7.2.6
+//! (velocities, accelerations, forces, face stresses, move constraints), initial stress,
+//! and the resets of 7.2.8.
+//!
+//! ```
+//! use pcdc_compute::{CpuBackend, Simulation};
+//! use pcdc_mech::{Boundary, LinearElastic, Mechanics};
+//! use pcdc_mesh::{builders, Range};
+//!
+//! let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.1).unwrap();
+//! let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
+//! let mut sim = Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+//!     .physics(Mechanics::new().material(Range::All, rock))
+//!     .physics(Boundary::new().fix(Range::group("bottom")))
+//!     .gravity([0.0, -9.81, 0.0])
+//!     .build()
+//!     .unwrap();
+//! sim.run(10).unwrap();
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod actions;
+mod boundary;
+mod error;
+pub mod kinematics;
+mod mechanics;
+mod model;
+pub mod output;
+
+pub use actions::{reset_displacement, reset_element_state, reset_velocity, set_velocity};
+pub use boundary::{Boundary, Components, Constraint, FaceStress, ACCEL_VELOCITY};
+pub use error::MechError;
+pub use mechanics::Mechanics;
+pub use model::{double_dot, ConstitutiveModel, LinearElastic, Sym6};

@@ -1,0 +1,170 @@
+//! The `ConstitutiveModel` plugin trait and isotropic linear elasticity (manual
+//! 7.2.2-7.2.3).
+//!
+//! Tensors are passed as 6-component arrays in the order xx, yy, zz, xy, yz, xz with
+//! tensor (not engineering) shear strains. In 2D (plane strain) the kinematics pass
+//! ε_zz = ε_yz = ε_xz = 0 and keep σ_zz.
+
+use serde::{Deserialize, Serialize};
+
+use crate::MechError;
+
+/// A symmetric tensor: xx, yy, zz, xy, yz, xz.
+pub type Sym6 = [f64; 6];
+
+/// A stress-strain law `σ(t+Δt) = H(σ(t), ε(t+Δt), Δε, history)` (manual eq. 12),
+/// evaluated in the element's co-rotated frame so that it needs no objective rates.
+pub trait ConstitutiveModel: Send + Sync + std::fmt::Debug {
+    /// Model name (for reports).
+    fn name(&self) -> &str;
+    /// Mass density ρ (kg/m³).
+    fn density(&self) -> f64;
+    /// Young's modulus E (Pa), used by the critical damping coefficient (eq. 18).
+    fn young(&self) -> f64;
+    /// P-wave (constrained) modulus M = K + 4G/3 (Pa) of the current tangent, used for the
+    /// stable time step and damping ratio.
+    fn wave_modulus(&self) -> f64;
+    /// Damping factor D_f of eq. 19 (dimensionless, ≥ 0).
+    fn damp_factor(&self) -> f64;
+    /// Number of history variables per element.
+    fn n_state(&self) -> usize {
+        0
+    }
+    /// Initial values of the history variables (default zero).
+    fn init_state_into(&self, state: &mut [f64]) {
+        state.fill(0.0);
+    }
+    /// Updates `stress` (in: σ(t), out: σ(t+Δt), Pa) from the total strain `strain` and
+    /// its increment `dstrain` over the step; `state` holds [`Self::n_state`] history
+    /// variables.
+    fn update(&self, strain: &Sym6, dstrain: &Sym6, stress: &mut Sym6, state: &mut [f64]);
+    /// The constant tangent `dσ/dε` as a 6x6 matrix acting on tensor strain components
+    /// (σ_xy = T[3][3] ε_xy, ...), if the model is linear; enables the direct static solve.
+    fn linear_tangent(&self) -> Option<[[f64; 6]; 6]> {
+        None
+    }
+}
+
+/// Isotropic linear elasticity (manual eq. 20-24), updated incrementally
+/// `σ += λ tr(Δε) I + 2μ Δε` so that initial stresses superpose.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LinearElastic {
+    /// Young's modulus E (Pa).
+    pub young: f64,
+    /// Poisson's ratio ν (-), 0 ≤ ν < 0.5.
+    pub poisson: f64,
+    /// Density ρ (kg/m³).
+    pub density: f64,
+    /// Damping factor D_f (eq. 19), default 0 (undamped).
+    pub damp_factor: f64,
+}
+
+impl LinearElastic {
+    /// From Young's modulus E (Pa), Poisson's ratio ν and density ρ (kg/m³).
+    pub fn new(young: f64, poisson: f64, density: f64) -> Result<Self, MechError> {
+        let m = LinearElastic { young, poisson, density, damp_factor: 0.0 };
+        m.check()?;
+        Ok(m)
+    }
+
+    /// From bulk modulus K (Pa), shear modulus G (Pa) and density (manual table 1,
+    /// keywords `bulk` and `shear`): E = 9KG/(3K+G), ν = (3K-2G)/(2(3K+G)).
+    pub fn from_bulk_shear(bulk: f64, shear: f64, density: f64) -> Result<Self, MechError> {
+        if !(bulk > 0.0 && bulk.is_finite()) {
+            return Err(MechError::param("bulk modulus K", bulk, "must be positive and finite"));
+        }
+        if !(shear > 0.0 && shear.is_finite()) {
+            return Err(MechError::param("shear modulus G", shear, "must be positive and finite"));
+        }
+        let young = 9.0 * bulk * shear / (3.0 * bulk + shear);
+        let poisson = (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear));
+        Self::new(young, poisson, density)
+    }
+
+    /// Sets the damping factor D_f (eq. 19).
+    pub fn with_damping(mut self, damp_factor: f64) -> Result<Self, MechError> {
+        self.damp_factor = damp_factor;
+        self.check()?;
+        Ok(self)
+    }
+
+    fn check(&self) -> Result<(), MechError> {
+        if !(self.young > 0.0 && self.young.is_finite()) {
+            return Err(MechError::param("Young's modulus E", self.young, "must be positive and finite"));
+        }
+        if !(0.0..0.5).contains(&self.poisson) {
+            return Err(MechError::param("Poisson's ratio ν", self.poisson, "must lie in [0, 0.5) (0.5 is incompressible, which explicit elements cannot represent)"));
+        }
+        if !(self.density > 0.0 && self.density.is_finite()) {
+            return Err(MechError::param("density ρ", self.density, "must be positive and finite"));
+        }
+        if !(self.damp_factor >= 0.0 && self.damp_factor.is_finite()) {
+            return Err(MechError::param("damping factor D_f", self.damp_factor, "must be non-negative and finite"));
+        }
+        Ok(())
+    }
+
+    /// Lamé's first parameter λ = Eν/((1+ν)(1-2ν)) (eq. 23), Pa.
+    pub fn lambda(&self) -> f64 {
+        self.young * self.poisson / ((1.0 + self.poisson) * (1.0 - 2.0 * self.poisson))
+    }
+
+    /// Shear modulus μ = G = E/(2(1+ν)) (eq. 24), Pa.
+    pub fn shear(&self) -> f64 {
+        self.young / (2.0 * (1.0 + self.poisson))
+    }
+
+    /// Bulk modulus K = λ + 2G/3, Pa.
+    pub fn bulk(&self) -> f64 {
+        self.lambda() + 2.0 * self.shear() / 3.0
+    }
+
+    /// σ = λ tr(ε) I + 2μ ε for a strain tensor.
+    pub fn stress_of(&self, e: &Sym6) -> Sym6 {
+        let (l, m) = (self.lambda(), self.shear());
+        let tr = e[0] + e[1] + e[2];
+        [l * tr + 2.0 * m * e[0], l * tr + 2.0 * m * e[1], l * tr + 2.0 * m * e[2], 2.0 * m * e[3], 2.0 * m * e[4], 2.0 * m * e[5]]
+    }
+}
+
+impl ConstitutiveModel for LinearElastic {
+    fn name(&self) -> &str {
+        "mech-iso-elastic"
+    }
+    fn density(&self) -> f64 {
+        self.density
+    }
+    fn young(&self) -> f64 {
+        self.young
+    }
+    fn wave_modulus(&self) -> f64 {
+        self.lambda() + 2.0 * self.shear()
+    }
+    fn damp_factor(&self) -> f64 {
+        self.damp_factor
+    }
+    #[inline]
+    fn update(&self, _strain: &Sym6, de: &Sym6, stress: &mut Sym6, _state: &mut [f64]) {
+        let ds = self.stress_of(de);
+        for k in 0..6 {
+            stress[k] += ds[k];
+        }
+    }
+    fn linear_tangent(&self) -> Option<[[f64; 6]; 6]> {
+        let (l, m) = (self.lambda(), self.shear());
+        let mut t = [[0.0; 6]; 6];
+        for i in 0..3 {
+            for j in 0..3 {
+                t[i][j] = l;
+            }
+            t[i][i] += 2.0 * m;
+            t[i + 3][i + 3] = 2.0 * m;
+        }
+        Some(t)
+    }
+}
+
+/// Double contraction σ:ε of two symmetric tensors.
+pub fn double_dot(a: &Sym6, b: &Sym6) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + 2.0 * (a[3] * b[3] + a[4] * b[4] + a[5] * b[5])
+}

@@ -1,0 +1,97 @@
+//! Output helpers: global stress, principal stresses, displacement, and a VTU/PVD
+//! writer for mechanical fields that ParaView opens.
+
+use pcdc_compute::{names, CpuBackend, Simulation};
+use pcdc_mesh::vtu::{DataArray, PvdSeries};
+use pcdc_mesh::Dim;
+
+use crate::actions::DISPLACEMENT_RESET;
+use crate::kinematics::{mul3, mul3_tn, polar_2d};
+use crate::MechError;
+
+/// Element Cauchy stress in the global frame (Pa, tension positive), stride NSYM
+/// (2D: xx, yy, xy; 3D: xx, yy, zz, xy, yz, xz): the co-rotated stress rotated by the
+/// element's current rotation, `R σ Rᵀ`.
+pub fn global_stress<D: Dim>(sim: &Simulation<D, CpuBackend>) -> Result<Vec<f64>, MechError> {
+    let s = sim.field(names::STRESS)?;
+    let mesh = sim.mesh();
+    let mut out = s.to_vec();
+    if D::D == 2 {
+        let x = sim.positions();
+        let mut xr = [0.0; 6];
+        for e in 0..mesh.n_elements() {
+            mesh.element_coords(e, &mut xr);
+            let c = mesh.element(e);
+            let p = |a: usize, k: usize| x[c[a] as usize * 2 + k];
+            let ds = [p(1, 0) - p(0, 0), p(2, 0) - p(0, 0), p(1, 1) - p(0, 1), p(2, 1) - p(0, 1)];
+            let dm = [xr[2] - xr[0], xr[4] - xr[0], xr[3] - xr[1], xr[5] - xr[1]];
+            let det = dm[0] * dm[3] - dm[1] * dm[2];
+            let mi = [dm[3] / det, -dm[1] / det, -dm[2] / det, dm[0] / det];
+            let f = [ds[0] * mi[0] + ds[1] * mi[2], ds[0] * mi[1] + ds[1] * mi[3], ds[2] * mi[0] + ds[3] * mi[2], ds[2] * mi[1] + ds[3] * mi[3]];
+            let (co, si) = polar_2d(&f);
+            let (a, b, cxy) = (s[3 * e], s[3 * e + 1], s[3 * e + 2]);
+            out[3 * e] = co * co * a - 2.0 * co * si * cxy + si * si * b;
+            out[3 * e + 1] = si * si * a + 2.0 * co * si * cxy + co * co * b;
+            out[3 * e + 2] = co * si * (a - b) + (co * co - si * si) * cxy;
+        }
+    } else {
+        let rot = sim.field(names::ROTATION)?;
+        for e in 0..mesh.n_elements() {
+            let r: [f64; 9] = rot[9 * e..9 * e + 9].try_into().expect("9 values");
+            let v = &s[6 * e..6 * e + 6];
+            let m = [v[0], v[3], v[5], v[3], v[1], v[4], v[5], v[4], v[2]];
+            let g = mul3(&r, &mul3_tn(&[r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]], &m));
+            out[6 * e..6 * e + 6].copy_from_slice(&[g[0], g[4], g[8], g[1], g[5], g[2]]);
+        }
+    }
+    Ok(out)
+}
+
+/// Principal stresses per element, descending (σ1 ≥ σ2 [≥ σ3]), Pa; in 2D the in-plane
+/// pair.
+pub fn principal_stress<D: Dim>(global: &[f64]) -> Vec<f64> {
+    if D::D == 2 {
+        global
+            .chunks_exact(3)
+            .flat_map(|s| {
+                let c = 0.5 * (s[0] + s[1]);
+                let r = (0.25 * (s[0] - s[1]).powi(2) + s[2] * s[2]).sqrt();
+                [c + r, c - r]
+            })
+            .collect()
+    } else {
+        global
+            .chunks_exact(6)
+            .flat_map(|s| {
+                let m = nalgebra::Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2]);
+                let mut ev: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+                ev.sort_by(|a, b| b.total_cmp(a));
+                ev
+            })
+            .collect()
+    }
+}
+
+/// Node displacement since the last [`crate::reset_displacement`] (m), stride D.
+pub fn displacement<D: Dim>(sim: &Simulation<D, CpuBackend>) -> Result<Vec<f64>, MechError> {
+    let off = sim.field(DISPLACEMENT_RESET)?;
+    Ok(sim.state.u.iter().zip(off).map(|(u, o)| u - o).collect())
+}
+
+/// Writes one VTU step with displacement, velocity, global stress, principal stresses and
+/// strain, on the deformed configuration.
+pub fn write_step<D: Dim>(series: &mut PvdSeries, sim: &Simulation<D, CpuBackend>) -> Result<std::path::PathBuf, MechError> {
+    let disp = displacement(sim)?;
+    let stress = global_stress(sim)?;
+    let principal = principal_stress::<D>(&stress);
+    let strain = sim.field(names::STRAIN)?;
+    let x = sim.positions();
+    let np = if D::D == 2 { 2 } else { 3 };
+    let mut cells = vec![DataArray::SymTensor { name: "stress", values: &stress }, DataArray::SymTensor { name: "strain", values: strain }];
+    let p1: Vec<f64> = principal.iter().step_by(np).copied().collect();
+    let pn: Vec<f64> = principal.iter().skip(np - 1).step_by(np).copied().collect();
+    cells.push(DataArray::Scalar { name: "sigma_1", values: &p1 });
+    cells.push(DataArray::Scalar { name: "sigma_min", values: &pn });
+    let path = series.write_step(sim.state.time, sim.mesh(), Some(&x), &[DataArray::Vector { name: "displacement", values: &disp }, DataArray::Vector { name: "velocity", values: &sim.state.v }], &cells)?;
+    Ok(path)
+}

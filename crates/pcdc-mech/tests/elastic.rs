@@ -1,0 +1,424 @@
+//! Elastic element mechanics: objectivity, patch tests, parameter checks, determinism,
+//! save/restore, watchdog and static solves against closed forms.
+
+use pcdc_compute::{ComputeError, CpuBackend, Simulation, StaticOptions, Table};
+use pcdc_mech::{output, set_velocity, Boundary, Constraint, FaceStress, LinearElastic, MechError, Mechanics};
+use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh, Range};
+use proptest::prelude::*;
+
+const E: f64 = 1.0e9;
+
+fn rock() -> LinearElastic {
+    LinearElastic::new(E, 0.25, 1000.0).unwrap()
+}
+
+fn cpu(t: usize) -> CpuBackend {
+    CpuBackend::new(t).unwrap()
+}
+
+fn free_sim<D: Dim>(mesh: Mesh<D>) -> Simulation<D> {
+    Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::All, rock())).build().unwrap()
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// Imposes `u = R(θ) X - X` and checks the stress stays zero at every angle of a turn.
+#[test]
+fn rigid_rotation_is_stress_free_2d_and_3d() {
+    let mut s2 = free_sim(builders::disc([0.3, -0.2], 1.0, 0.2).unwrap());
+    let x0 = s2.mesh().coords().to_vec();
+    for k in 0..=64 {
+        let t = 2.0 * std::f64::consts::PI * k as f64 / 64.0;
+        let (c, s) = (t.cos(), t.sin());
+        for (i, p) in x0.chunks_exact(2).enumerate() {
+            s2.state.u[2 * i] = c * p[0] - s * p[1] - p[0];
+            s2.state.u[2 * i + 1] = s * p[0] + c * p[1] - p[1];
+        }
+        let f = max_abs(s2.evaluate_forces().unwrap());
+        let st = max_abs(&output::global_stress(&s2).unwrap());
+        assert!(st < 1e-9 * E, "2D angle {t}: stress {st}");
+        assert!(f < 1e-9 * E, "2D angle {t}: force {f}");
+    }
+    let mut s3 = free_sim(builders::cuboid([0.0; 3], [1.0, 0.5, 0.7], 0.25).unwrap());
+    let x0 = s3.mesh().coords().to_vec();
+    let axis = [1.0f64, 2.0, 2.0].map(|v| v / 3.0);
+    for k in 0..=64 {
+        let t = 2.0 * std::f64::consts::PI * k as f64 / 64.0;
+        let (c, s) = (t.cos(), t.sin());
+        for (i, p) in x0.chunks_exact(3).enumerate() {
+            // Rodrigues' rotation about `axis`.
+            let kx = [axis[1] * p[2] - axis[2] * p[1], axis[2] * p[0] - axis[0] * p[2], axis[0] * p[1] - axis[1] * p[0]];
+            let kd = axis[0] * p[0] + axis[1] * p[1] + axis[2] * p[2];
+            for j in 0..3 {
+                s3.state.u[3 * i + j] = p[j] * c + kx[j] * s + axis[j] * kd * (1.0 - c) - p[j];
+            }
+        }
+        s3.evaluate_forces().unwrap();
+        let st = max_abs(&output::global_stress(&s3).unwrap());
+        assert!(st < 1e-9 * E, "3D angle {t}: stress {st}");
+    }
+}
+
+/// A free body given a rigid spin turns through a full revolution dynamically without
+/// spurious stress (centrifugal stress ρω²R² is 1e-10 E here).
+#[test]
+fn free_spin_through_a_full_turn() {
+    let mesh = builders::disc([0.0, 0.0], 1.0, 0.4).unwrap();
+    let mut sim = Simulation::builder(mesh, cpu(2)).physics(Mechanics::new().material(Range::All, LinearElastic::new(E, 0.25, 1000.0).unwrap())).build().unwrap();
+    // ωR/c = 2e-4: real centrifugal stress ~ (ωR/c)² E = 4e-8 E, far below the bound.
+    let omega = 2e-4 * (E / 1000.0f64).sqrt();
+    let x0 = sim.mesh().coords().to_vec();
+    for (i, p) in x0.chunks_exact(2).enumerate() {
+        sim.state.v[2 * i] = -omega * p[1];
+        sim.state.v[2 * i + 1] = omega * p[0];
+    }
+    let turn = 2.0 * std::f64::consts::PI / omega;
+    sim.run_until(turn).unwrap();
+    let st = max_abs(&output::global_stress(&sim).unwrap());
+    let centrifugal = 1000.0 * omega * omega * 1.0;
+    assert!(st < 1e-6 * E, "stress after one turn {st:e} (centrifugal scale {centrifugal:e})");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Patch test on randomly distorted meshes: a linear displacement field gives the same
+    /// stress in every element (to 1e-10 relative), equal to the closed form for the
+    /// imposed deformation gradient, and zero force at interior nodes.
+    #[test]
+    fn patch_test_2d(seed in 0u64..10_000, a in proptest::array::uniform4(-1e-3f64..1e-3)) {
+        let mesh = distorted_rectangle(seed);
+        let mut sim = free_sim(mesh);
+        let x0 = sim.mesh().coords().to_vec();
+        for (i, p) in x0.chunks_exact(2).enumerate() {
+            sim.state.u[2 * i] = a[0] * p[0] + a[1] * p[1];
+            sim.state.u[2 * i + 1] = a[2] * p[0] + a[3] * p[1];
+        }
+        let f = sim.evaluate_forces().unwrap().to_vec();
+        let stress = output::global_stress(&sim).unwrap();
+        // Closed form: F = I + A, R from the polar decomposition, ε = RᵀF - I, σ = R (C:ε) Rᵀ.
+        let fm = [1.0 + a[0], a[1], a[2], 1.0 + a[3]];
+        let (c, s) = pcdc_mech::kinematics::polar_2d(&fm);
+        let u = [c * fm[0] + s * fm[2], c * fm[1] + s * fm[3], -s * fm[0] + c * fm[2], -s * fm[1] + c * fm[3]];
+        let eps = [u[0] - 1.0, u[3] - 1.0, 0.0, 0.5 * (u[1] + u[2]), 0.0, 0.0];
+        let sl = rock().stress_of(&eps);
+        let g = [c * c * sl[0] - 2.0 * c * s * sl[3] + s * s * sl[1], s * s * sl[0] + 2.0 * c * s * sl[3] + c * c * sl[1], c * s * (sl[0] - sl[1]) + (c * c - s * s) * sl[3]];
+        let scale = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for e in stress.chunks_exact(3) {
+            for k in 0..3 {
+                prop_assert!((e[k] - g[k]).abs() <= 1e-10 * scale, "stress {:?} vs {:?}", e, g);
+            }
+        }
+        let boundary = sim.mesh().nodes_of_faces(&sim.mesh().faces().boundary);
+        let fscale = scale * 0.1;
+        for n in 0..sim.mesh().n_nodes() {
+            if boundary.binary_search(&(n as u32)).is_err() {
+                prop_assert!(f[2 * n].abs() < 1e-10 * fscale && f[2 * n + 1].abs() < 1e-10 * fscale, "interior node {} force {} {}", n, f[2 * n], f[2 * n + 1]);
+            }
+        }
+    }
+
+    /// Element forces are self-equilibrated: zero resultant and zero moment (the Cauchy
+    /// stress is symmetric), for random deformed tetrahedra.
+    #[test]
+    fn element_forces_balance_3d(d in proptest::collection::vec(-0.05f64..0.05, 12)) {
+        let coords = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        let mut sim = free_sim(Mesh::<Dim3>::new(coords, vec![0, 1, 2, 3]).unwrap());
+        sim.state.u.copy_from_slice(&d);
+        let f = sim.evaluate_forces().unwrap().to_vec();
+        let x = sim.positions();
+        let scale = max_abs(&f).max(1.0);
+        for k in 0..3 {
+            let sum: f64 = (0..4).map(|n| f[3 * n + k]).sum();
+            prop_assert!(sum.abs() < 1e-9 * scale);
+        }
+        let mut m = [0.0; 3];
+        for n in 0..4 {
+            let (p, q) = (&x[3 * n..3 * n + 3], &f[3 * n..3 * n + 3]);
+            m[0] += p[1] * q[2] - p[2] * q[1];
+            m[1] += p[2] * q[0] - p[0] * q[2];
+            m[2] += p[0] * q[1] - p[1] * q[0];
+        }
+        prop_assert!(max_abs(&m) < 1e-9 * scale, "moment {:?}", m);
+    }
+}
+
+/// A rectangle mesh with interior nodes moved randomly by up to 30 % of the cell size.
+fn distorted_rectangle(seed: u64) -> Mesh<Dim2> {
+    let base = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.2).unwrap();
+    let boundary = base.nodes_of_faces(&base.faces().boundary);
+    let mut coords = base.coords().to_vec();
+    let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    let mut rnd = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    for n in 0..base.n_nodes() {
+        if boundary.binary_search(&(n as u32)).is_err() {
+            coords[2 * n] += 0.06 * rnd();
+            coords[2 * n + 1] += 0.06 * rnd();
+        }
+    }
+    Mesh::new(coords, base.elements().to_vec()).unwrap()
+}
+
+#[test]
+fn invalid_parameters_are_errors() {
+    assert!(matches!(LinearElastic::new(1e9, 0.5, 1000.0), Err(MechError::InvalidParameter { .. })));
+    let e = LinearElastic::new(-1e9, 0.25, 1000.0).unwrap_err();
+    assert!(e.to_string().contains("Young"), "{e}");
+    assert!(LinearElastic::new(1e9, 0.25, 0.0).is_err());
+    assert!(LinearElastic::new(1e9, 0.25, 1.0).unwrap().with_damping(-1.0).is_err());
+    assert!(LinearElastic::from_bulk_shear(1e9, -1.0, 1000.0).is_err());
+    // K/G giving ν < 0 is refused too.
+    assert!(LinearElastic::from_bulk_shear(1e9, 2e9, 1000.0).is_err());
+    // A mesh without a material for every element is an error naming the element.
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    let err = Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::rect(0.0, 0.0, 0.5, 1.0), rock())).build().err().unwrap();
+    assert!(err.to_string().contains("element"), "{err}");
+    // A boundary range that selects nothing is an error.
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    let err = Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::All, rock())).physics(Boundary::new().fix(Range::rect(5.0, 5.0, 6.0, 6.0))).build().err().unwrap();
+    assert!(err.to_string().contains("selects no node"), "{err}");
+}
+
+proptest! {
+    #[test]
+    fn bulk_shear_and_young_poisson_agree(e in 1e6f64..1e11, nu in 0.0f64..0.49) {
+        let a = LinearElastic::new(e, nu, 2000.0).unwrap();
+        let b = LinearElastic::from_bulk_shear(a.bulk(), a.shear(), 2000.0).unwrap();
+        prop_assert!((a.lambda() - b.lambda()).abs() <= 1e-9 * e);
+        prop_assert!((a.shear() - b.shear()).abs() <= 1e-9 * e);
+        prop_assert!((a.young - b.young).abs() <= 1e-9 * e);
+    }
+
+    #[test]
+    fn elastic_energy_positive_and_zero_at_zero(e in 1e6f64..1e11, nu in 0.0f64..0.49, s in proptest::array::uniform6(-1e-3f64..1e-3)) {
+        use pcdc_mech::ConstitutiveModel;
+        let m = LinearElastic::new(e, nu, 2000.0).unwrap();
+        let mut zero = [0.0; 6];
+        m.update(&[0.0; 6], &[0.0; 6], &mut zero, &mut []);
+        prop_assert_eq!(zero, [0.0; 6]);
+        let sig = m.stress_of(&s);
+        let w = 0.5 * pcdc_mech::double_dot(&sig, &s);
+        prop_assume!(s.iter().any(|v| v.abs() > 1e-9));
+        prop_assert!(w > 0.0);
+        // The tangent reproduces the update.
+        let t = m.linear_tangent().unwrap();
+        for i in 0..6 {
+            let v: f64 = (0..6).map(|j| t[i][j] * s[j]).sum();
+            prop_assert!((v - sig[i]).abs() <= 1e-9 * e * 1e-3);
+        }
+    }
+}
+
+fn loaded_block(threads: usize) -> Simulation<Dim2> {
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.1).unwrap();
+    let vel = Table::new("top velocity", &[(0.0, 0.0), (1e-3, -0.05)]).unwrap();
+    Simulation::builder(mesh, cpu(threads))
+        .physics(Mechanics::new().material(Range::All, rock().with_damping(0.1).unwrap()))
+        .physics(Boundary::new().fix(Range::group("bottom")).velocity(Range::group("top"), [None, Some(vel.into()), None]))
+        .gravity([0.0, -9.81, 0.0])
+        .build()
+        .unwrap()
+}
+
+#[test]
+fn identical_results_for_any_thread_count() {
+    let mut a = loaded_block(1);
+    let mut b = loaded_block(2);
+    a.run(300).unwrap();
+    b.run(300).unwrap();
+    assert!(a.state.u.iter().zip(&b.state.u).all(|(x, y)| x.to_bits() == y.to_bits()));
+    assert!(a.field("stress").unwrap().iter().zip(b.field("stress").unwrap()).all(|(x, y)| x.to_bits() == y.to_bits()));
+}
+
+#[test]
+fn save_restore_continues_bit_for_bit() {
+    let dir = std::env::temp_dir().join(format!("pcdc-snap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("block.snap");
+    let mut a = loaded_block(2);
+    a.run(150).unwrap();
+    a.save(&path).unwrap();
+    a.run(150).unwrap();
+    let mut b = loaded_block(2);
+    b.restore(&path).unwrap();
+    assert_eq!(b.state.step, 150);
+    b.run(150).unwrap();
+    assert_eq!(a.state.time.to_bits(), b.state.time.to_bits());
+    assert!(a.state.u.iter().zip(&b.state.u).all(|(x, y)| x.to_bits() == y.to_bits()));
+    assert!(a.state.v.iter().zip(&b.state.v).all(|(x, y)| x.to_bits() == y.to_bits()));
+    // A snapshot of another scene is refused.
+    let mut other = free_sim(builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap());
+    assert!(matches!(other.restore(&path), Err(ComputeError::SnapshotMismatch(_))));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn watchdog_names_step_and_node() {
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.1).unwrap();
+    let mut sim = Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::All, rock())).physics(Boundary::new().fix(Range::group("bottom"))).gravity([0.0, -9.81, 0.0]).time_step(1e-3).build().unwrap();
+    let limit = sim.time_step_limit().unwrap().clone();
+    assert!(limit.entity.starts_with("element "), "{limit:?}");
+    assert!(limit.dt < 1e-3);
+    let err = sim.run(100_000).unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, ComputeError::Diverged { .. }), "{msg}");
+    assert!(msg.contains("step") && msg.contains("node") && msg.contains("Hint"), "{msg}");
+}
+
+/// Uniaxial strain column under a top stress, sides on rollers: σ_yy = p everywhere and
+/// u_y(top) = p H / M with the constrained modulus M. Both static solvers.
+#[test]
+fn static_solvers_match_uniaxial_strain() {
+    let p = -2.0e6;
+    let h = 2.0;
+    let build = || {
+        let mesh = builders::rectangle(0.0, 0.0, 1.0, h, 0.25).unwrap();
+        Simulation::builder(mesh, cpu(2))
+            .physics(Mechanics::new().material(Range::All, rock()))
+            .physics(
+                Boundary::new()
+                    .constraint(Range::group("bottom"), Constraint::Line([1.0, 0.0, 0.0]))
+                    .constraint(Range::group("left"), Constraint::Line([0.0, 1.0, 0.0]))
+                    .constraint(Range::group("right"), Constraint::Line([0.0, 1.0, 0.0]))
+                    .face_stress(Range::group("top"), FaceStress { yy: Some(p.into()), ..Default::default() }),
+            )
+            .build()
+            .unwrap()
+    };
+    let m = rock().lambda() + 2.0 * rock().shear();
+    let expect = p * h / m;
+    let mut direct = build();
+    let rep = direct.solve_linear(&StaticOptions { tolerance: 1e-9, ..Default::default() }).unwrap();
+    let mut relaxed = build();
+    let rep2 = relaxed.relax(&StaticOptions { tolerance: 1e-7, ..Default::default() }).unwrap();
+    for (name, sim) in [("direct", &direct), ("relaxation", &relaxed)] {
+        let top = sim.mesh().select_nodes(&Range::group("top")).unwrap();
+        for &n in &top {
+            let uy = sim.state.u[2 * n as usize + 1];
+            assert!((uy - expect).abs() < 1e-4 * expect.abs(), "{name}: u_y {uy} vs {expect}");
+        }
+        let s = output::global_stress(sim).unwrap();
+        for e in s.chunks_exact(3) {
+            assert!((e[1] - p).abs() < 1e-4 * p.abs(), "{name}: σyy {} vs {p}", e[1]);
+        }
+    }
+    assert!(rep.steps <= 3, "{rep:?}");
+    assert!(rep2.steps > 0);
+}
+
+/// A disc under a normal (follower) pressure: uniform in-plane hydrostatic stress.
+#[test]
+fn normal_face_stress_gives_hydrostatic_disc() {
+    let mesh = builders::disc([0.0, 0.0], 1.0, 0.2).unwrap();
+    let mut sim = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(
+            Boundary::new()
+                .face_stress(Range::group("boundary"), FaceStress::normal(-1.0e6))
+                .constraint(Range::Ball { center: [0.0; 3], radius: 1e-9 }, Constraint::Fixed)
+                .constraint(Range::plane([0.0; 3], [0.0, 1.0, 0.0], 1e-9).and(Range::Ball { center: [1.0, 0.0, 0.0], radius: 1e-6 }), Constraint::Line([1.0, 0.0, 0.0])),
+        )
+        .build()
+        .unwrap();
+    sim.solve_linear(&StaticOptions::default()).unwrap();
+    let s = output::global_stress(&sim).unwrap();
+    for e in s.chunks_exact(3) {
+        assert!((e[0] + 1.0e6).abs() < 1e-3 * 1e6 && (e[1] + 1.0e6).abs() < 1e-3 * 1e6 && e[2].abs() < 1e-3 * 1e6, "{e:?}");
+    }
+}
+
+#[test]
+fn node_force_acceleration_and_line_constraint() {
+    // A free block pushed by node forces accelerates as F/m; a node on a 45° line
+    // constraint moves along it; a prescribed acceleration integrates to v = a t.
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    let total_mass = 1000.0;
+    let mut sim = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(Boundary::new().node_force(Range::All, [Some(10.0.into()), None, None]))
+        .build()
+        .unwrap();
+    let n = sim.mesh().n_nodes() as f64;
+    let dt = sim.dt();
+    sim.run(100).unwrap();
+    let momentum: f64 = sim.state.v.chunks_exact(2).zip(sim.mass()).map(|(v, m)| m * v[0]).sum();
+    let expect = 10.0 * n * 100.0 * dt;
+    assert!((sim.mass().iter().sum::<f64>() - total_mass).abs() < 1e-9 * total_mass);
+    assert!((momentum - expect).abs() < 1e-9 * expect, "{momentum} vs {expect}");
+
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    let mut sim = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(Boundary::new().acceleration(Range::group("bottom"), [Some(2.0.into()), None, None]).constraint(Range::group("top"), Constraint::Line([1.0, 1.0, 0.0])))
+        .build()
+        .unwrap();
+    set_velocity(&mut sim, &Range::group("top"), [0.3, -0.1, 0.0]).unwrap();
+    sim.run(50).unwrap();
+    let bottom = sim.mesh().select_nodes(&Range::group("bottom")).unwrap();
+    for &b in &bottom {
+        let v = sim.state.v[2 * b as usize];
+        assert!((v - 2.0 * sim.state.time).abs() < 1e-9, "{v}");
+    }
+    let top = sim.mesh().select_nodes(&Range::group("top")).unwrap();
+    for &t in &top {
+        let u = &sim.state.u[2 * t as usize..2 * t as usize + 2];
+        assert!((u[0] - u[1]).abs() < 1e-12 * u[0].abs().max(1e-12), "{u:?}");
+    }
+}
+
+#[test]
+fn damping_reduces_the_stable_step_and_dissipates() {
+    let mk = |df: f64| {
+        let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.2, 0.05).unwrap();
+        let mut sim = Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::All, rock().with_damping(df).unwrap())).build().unwrap();
+        let x0 = sim.mesh().coords().to_vec();
+        for (i, p) in x0.chunks_exact(2).enumerate() {
+            sim.state.u[2 * i] = 1e-4 * p[0];
+        }
+        sim
+    };
+    let (mut a, mut b) = (mk(0.0), mk(1.0));
+    assert!(b.dt() < 0.5 * a.dt(), "{} vs {}", b.dt(), a.dt());
+    a.evaluate_forces().unwrap();
+    let e0 = a.stored_energy();
+    assert!(e0 > 0.0);
+    a.run_until(2e-3).unwrap();
+    b.run_until(2e-3).unwrap();
+    let ea = a.stored_energy() + a.kinetic_energy();
+    let eb = b.stored_energy() + b.kinetic_energy();
+    assert!((ea - e0).abs() < 0.02 * e0, "undamped energy {ea} vs {e0}");
+    assert!(eb < 0.2 * e0, "damped energy {eb} vs {e0}");
+}
+
+#[test]
+fn resets_between_stages() {
+    let mut sim = loaded_block(1);
+    sim.run(200).unwrap();
+    assert!(max_abs(&output::displacement(&sim).unwrap()) > 0.0);
+    pcdc_mech::reset_displacement(&mut sim, &Range::All).unwrap();
+    assert_eq!(max_abs(&output::displacement(&sim).unwrap()), 0.0);
+    pcdc_mech::reset_velocity(&mut sim, &Range::All).unwrap();
+    assert_eq!(max_abs(&sim.state.v), 0.0);
+    pcdc_mech::reset_element_state(&mut sim, &Range::All).unwrap();
+    assert_eq!(max_abs(sim.field("stress").unwrap()), 0.0);
+}
+
+#[test]
+fn initial_stress_is_kept_in_equilibrium() {
+    // A free body with a uniform initial stress and matching face tractions stays put.
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
+    let s0 = [-1e6, -2e6, -0.75e6, 0.0, 0.0, 0.0];
+    let mut sim = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()).initial_stress(Range::All, s0))
+        .physics(Boundary::new().face_stress(Range::All, FaceStress::diagonal(s0[0], s0[1], 0.0)))
+        .build()
+        .unwrap();
+    sim.run(100).unwrap();
+    assert!(max_abs(&sim.state.u) < 1e-15, "{}", max_abs(&sim.state.u));
+    let _ = Dim2::NAME;
+}

@@ -1,0 +1,496 @@
+//! The struct-of-arrays mesh: nodes, one simplex element block, faces and groups.
+
+use std::collections::{BTreeMap, HashMap};
+use std::marker::PhantomData;
+
+use crate::{Dim, MeshError, Range};
+
+/// Marker for "no neighbouring element" in [`Faces::neighbor`].
+pub const NO_NEIGHBOR: u32 = u32::MAX;
+
+/// Relative threshold under which an element counts as degenerate: its measure is
+/// compared with `DEGENERATE_REL * (longest edge)^D`.
+pub const DEGENERATE_REL: f64 = 1e-10;
+
+/// All unique element faces (edges in 2D, triangles in 3D) with their adjacency.
+///
+/// Face `i` has nodes `nodes[i*NPF..(i+1)*NPF]`, ordered so that its normal points out of
+/// its `owner` element. `neighbor[i]` is the element on the other side, or [`NO_NEIGHBOR`]
+/// for a boundary face.
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+pub struct Faces {
+    /// Face nodes, stride `NODES_PER_FACE`, outward for the owner.
+    pub nodes: Vec<u32>,
+    /// Element owning the face (the first one met in element order).
+    pub owner: Vec<u32>,
+    /// Local face index within the owner.
+    pub owner_local: Vec<u8>,
+    /// Element on the other side, or [`NO_NEIGHBOR`].
+    pub neighbor: Vec<u32>,
+    /// Indices of the boundary faces, ascending.
+    pub boundary: Vec<u32>,
+}
+
+impl Faces {
+    /// Number of faces.
+    pub fn len(&self) -> usize {
+        self.owner.len()
+    }
+
+    /// Whether there are no faces.
+    pub fn is_empty(&self) -> bool {
+        self.owner.is_empty()
+    }
+}
+
+/// Named groups of nodes, elements and faces (PCDC's "ranges" by set/group).
+///
+/// Each group is a sorted list of unique indices. Group names are free text; a common
+/// convention is `set/group` when an entity must belong to groups in several sets.
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+pub struct Groups {
+    /// Node groups.
+    pub nodes: BTreeMap<String, Vec<u32>>,
+    /// Element groups.
+    pub elements: BTreeMap<String, Vec<u32>>,
+    /// Face groups (indices into [`Faces`]).
+    pub faces: BTreeMap<String, Vec<u32>>,
+}
+
+/// A mesh of one simplex element type (Tri3 in 2D, Tet4 in 3D), stored as structure of
+/// arrays: `coords` with stride `D`, `elements` with stride `NODES_PER_ELEM`, indices `u32`.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(bound = "")]
+pub struct Mesh<D: Dim> {
+    coords: Vec<f64>,
+    elements: Vec<u32>,
+    faces: Faces,
+    groups: Groups,
+    #[serde(skip)]
+    _dim: PhantomData<D>,
+}
+
+impl<D: Dim> Mesh<D> {
+    /// Builds a mesh and checks it: array lengths, finite coordinates, node indices,
+    /// repeated nodes, inverted and degenerate elements, dangling nodes, manifold faces.
+    ///
+    /// `coords` holds `D` values per node (m); `elements` holds `NODES_PER_ELEM` node
+    /// indices per element, counter-clockwise (Tri3) or positively oriented (Tet4).
+    pub fn new(coords: Vec<f64>, elements: Vec<u32>) -> Result<Self, MeshError> {
+        Self::build(coords, elements, false)
+    }
+
+    /// Like [`Mesh::new`] but swaps two nodes of every inverted element instead of
+    /// failing (for generated or imported meshes whose orientation is arbitrary).
+    pub fn new_reoriented(coords: Vec<f64>, elements: Vec<u32>) -> Result<Self, MeshError> {
+        Self::build(coords, elements, true)
+    }
+
+    fn build(coords: Vec<f64>, mut elements: Vec<u32>, reorient: bool) -> Result<Self, MeshError> {
+        let (d, npe) = (D::D, D::NODES_PER_ELEM);
+        if coords.len() % d != 0 {
+            return Err(MeshError::CoordLength { len: coords.len(), dim: d });
+        }
+        if elements.len() % npe != 0 {
+            return Err(MeshError::ConnectivityLength { len: elements.len(), per_elem: npe });
+        }
+        if elements.is_empty() {
+            return Err(MeshError::Empty);
+        }
+        let n_nodes = coords.len() / d;
+        if let Some(i) = coords.iter().position(|v| !v.is_finite()) {
+            return Err(MeshError::NonFiniteCoordinate { node: i / d });
+        }
+        let measure_name = if d == 2 { "area" } else { "volume" };
+        let mut used = vec![false; n_nodes];
+        let mut x = vec![0.0; npe * d];
+        for (e, conn) in elements.chunks_exact_mut(npe).enumerate() {
+            for (a, &n) in conn.iter().enumerate() {
+                if n as usize >= n_nodes {
+                    return Err(MeshError::BadNodeIndex { element: e, node: n, n_nodes });
+                }
+                if conn[..a].contains(&n) {
+                    return Err(MeshError::RepeatedNode { element: e, node: n });
+                }
+            }
+            for (a, &n) in conn.iter().enumerate() {
+                x[a * d..(a + 1) * d].copy_from_slice(&coords[n as usize * d..(n as usize + 1) * d]);
+                used[n as usize] = true;
+            }
+            let mut measure = D::signed_measure(&x);
+            let mut longest = 0.0f64;
+            for a in 0..npe {
+                for b in a + 1..npe {
+                    let l2: f64 = (0..d).map(|k| (x[a * d + k] - x[b * d + k]).powi(2)).sum();
+                    longest = longest.max(l2.sqrt());
+                }
+            }
+            let threshold = DEGENERATE_REL * longest.powi(d as i32);
+            if measure.is_nan() || measure.abs() <= threshold {
+                return Err(MeshError::DegenerateElement { element: e, measure, threshold, measure_name });
+            }
+            if measure < 0.0 {
+                if !reorient {
+                    return Err(MeshError::InvertedElement { element: e, measure, measure_name });
+                }
+                conn.swap(0, 1);
+                measure = -measure;
+            }
+        }
+        if let Some(node) = used.iter().position(|u| !u) {
+            return Err(MeshError::DanglingNode { node });
+        }
+        let faces = build_faces::<D>(&elements)?;
+        Ok(Mesh { coords, elements, faces, groups: Groups::default(), _dim: PhantomData })
+    }
+
+    /// Number of nodes.
+    pub fn n_nodes(&self) -> usize {
+        self.coords.len() / D::D
+    }
+
+    /// Number of elements.
+    pub fn n_elements(&self) -> usize {
+        self.elements.len() / D::NODES_PER_ELEM
+    }
+
+    /// Node coordinates, stride `D` (m).
+    pub fn coords(&self) -> &[f64] {
+        &self.coords
+    }
+
+    /// Coordinates of node `i`.
+    pub fn node(&self, i: usize) -> &[f64] {
+        &self.coords[i * D::D..(i + 1) * D::D]
+    }
+
+    /// Element connectivity, stride `NODES_PER_ELEM`.
+    pub fn elements(&self) -> &[u32] {
+        &self.elements
+    }
+
+    /// Nodes of element `e`.
+    pub fn element(&self, e: usize) -> &[u32] {
+        &self.elements[e * D::NODES_PER_ELEM..(e + 1) * D::NODES_PER_ELEM]
+    }
+
+    /// Faces and adjacency.
+    pub fn faces(&self) -> &Faces {
+        &self.faces
+    }
+
+    /// Nodes of face `f`.
+    pub fn face(&self, f: usize) -> &[u32] {
+        &self.faces.nodes[f * D::NODES_PER_FACE..(f + 1) * D::NODES_PER_FACE]
+    }
+
+    /// Groups.
+    pub fn groups(&self) -> &Groups {
+        &self.groups
+    }
+
+    /// Gathers the coordinates of element `e` into `x` (`NODES_PER_ELEM * D` values).
+    pub fn element_coords(&self, e: usize, x: &mut [f64]) {
+        let d = D::D;
+        for (a, &n) in self.element(e).iter().enumerate() {
+            x[a * d..(a + 1) * d].copy_from_slice(self.node(n as usize));
+        }
+    }
+
+    /// Area (2D) or volume (3D) of element `e` (m² or m³).
+    pub fn element_measure(&self, e: usize) -> f64 {
+        let mut x = [0.0; 12];
+        self.element_coords(e, &mut x[..D::NODES_PER_ELEM * D::D]);
+        D::signed_measure(&x[..D::NODES_PER_ELEM * D::D])
+    }
+
+    /// Centroid of element `e` written into `c` (length `D`).
+    pub fn element_centroid(&self, e: usize, c: &mut [f64]) {
+        centroid::<D>(&self.coords, self.element(e), c);
+    }
+
+    /// Centroid of face `f` written into `c` (length `D`).
+    pub fn face_centroid(&self, f: usize, c: &mut [f64]) {
+        centroid::<D>(&self.coords, self.face(f), c);
+    }
+
+    /// Length (2D) or area (3D) of face `f` and its outward unit normal (for the owner).
+    pub fn face_measure_normal(&self, f: usize, normal: &mut [f64]) -> f64 {
+        let d = D::D;
+        let mut x = [0.0; 9];
+        for (k, &n) in self.face(f).iter().enumerate() {
+            x[k * d..(k + 1) * d].copy_from_slice(self.node(n as usize));
+        }
+        D::face_measure_normal(&x[..D::NODES_PER_FACE * d], normal)
+    }
+
+    /// Axis-aligned bounding box `(min, max)`, each of length `D`.
+    pub fn bounding_box(&self) -> (Vec<f64>, Vec<f64>) {
+        let d = D::D;
+        let mut lo = vec![f64::INFINITY; d];
+        let mut hi = vec![f64::NEG_INFINITY; d];
+        for p in self.coords.chunks_exact(d) {
+            for k in 0..d {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Smallest and largest element edge length (m).
+    pub fn edge_length_range(&self) -> (f64, f64) {
+        let (d, npe) = (D::D, D::NODES_PER_ELEM);
+        let mut lo = f64::INFINITY;
+        let mut hi = 0.0f64;
+        for conn in self.elements.chunks_exact(npe) {
+            for a in 0..npe {
+                for b in a + 1..npe {
+                    let (p, q) = (self.node(conn[a] as usize), self.node(conn[b] as usize));
+                    let l = (0..d).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>().sqrt();
+                    lo = lo.min(l);
+                    hi = hi.max(l);
+                }
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Adds (or replaces) a node group; indices are sorted and de-duplicated.
+    pub fn add_node_group(&mut self, name: impl Into<String>, mut nodes: Vec<u32>) -> Result<(), MeshError> {
+        let name = name.into();
+        check_indices("node", &name, &nodes, self.n_nodes())?;
+        nodes.sort_unstable();
+        nodes.dedup();
+        self.groups.nodes.insert(name, nodes);
+        Ok(())
+    }
+
+    /// Adds (or replaces) an element group.
+    pub fn add_element_group(&mut self, name: impl Into<String>, mut elems: Vec<u32>) -> Result<(), MeshError> {
+        let name = name.into();
+        check_indices("element", &name, &elems, self.n_elements())?;
+        elems.sort_unstable();
+        elems.dedup();
+        self.groups.elements.insert(name, elems);
+        Ok(())
+    }
+
+    /// Adds (or replaces) a face group.
+    pub fn add_face_group(&mut self, name: impl Into<String>, mut faces: Vec<u32>) -> Result<(), MeshError> {
+        let name = name.into();
+        check_indices("face", &name, &faces, self.faces.len())?;
+        faces.sort_unstable();
+        faces.dedup();
+        self.groups.faces.insert(name, faces);
+        Ok(())
+    }
+
+    /// Adds a node group, an element group and a boundary-face group, all named `name`,
+    /// from one geometric range (nodes by position, elements and faces by centroid).
+    pub fn add_groups_from_range(&mut self, name: &str, range: &Range) -> Result<(), MeshError> {
+        let nodes = self.select_nodes(range)?;
+        let elems = self.select_elements(range)?;
+        let faces = self.select_boundary_faces(range)?;
+        self.add_node_group(name, nodes)?;
+        self.add_element_group(name, elems)?;
+        self.add_face_group(name, faces)
+    }
+
+    fn check_range(&self, kind: &'static str, map: &BTreeMap<String, Vec<u32>>, range: &Range) -> Result<(), MeshError> {
+        range.validate()?;
+        let mut names = Vec::new();
+        range.group_names(&mut names);
+        for n in names {
+            if !map.contains_key(n) {
+                return Err(MeshError::UnknownGroup { kind, name: n.to_string() });
+            }
+        }
+        Ok(())
+    }
+
+    /// Nodes in `range` (by position), ascending.
+    pub fn select_nodes(&self, range: &Range) -> Result<Vec<u32>, MeshError> {
+        self.check_range("node", &self.groups.nodes, range)?;
+        let g = &self.groups.nodes;
+        Ok((0..self.n_nodes() as u32)
+            .filter(|&i| range.contains(self.node(i as usize), &|name| member(g, name, i)))
+            .collect())
+    }
+
+    /// Elements in `range` (by centroid), ascending.
+    pub fn select_elements(&self, range: &Range) -> Result<Vec<u32>, MeshError> {
+        self.check_range("element", &self.groups.elements, range)?;
+        let g = &self.groups.elements;
+        let mut c = [0.0; 3];
+        Ok((0..self.n_elements() as u32)
+            .filter(|&e| {
+                self.element_centroid(e as usize, &mut c[..D::D]);
+                range.contains(&c[..D::D], &|name| member(g, name, e))
+            })
+            .collect())
+    }
+
+    /// Boundary faces in `range` (by centroid), ascending face indices.
+    pub fn select_boundary_faces(&self, range: &Range) -> Result<Vec<u32>, MeshError> {
+        self.select_faces_in(range, &self.faces.boundary)
+    }
+
+    /// All faces (interior and boundary) in `range` (by centroid), ascending.
+    pub fn select_faces(&self, range: &Range) -> Result<Vec<u32>, MeshError> {
+        let all: Vec<u32> = (0..self.faces.len() as u32).collect();
+        self.select_faces_in(range, &all)
+    }
+
+    fn select_faces_in(&self, range: &Range, candidates: &[u32]) -> Result<Vec<u32>, MeshError> {
+        self.check_range("face", &self.groups.faces, range)?;
+        let g = &self.groups.faces;
+        let mut c = [0.0; 3];
+        Ok(candidates
+            .iter()
+            .copied()
+            .filter(|&f| {
+                self.face_centroid(f as usize, &mut c[..D::D]);
+                range.contains(&c[..D::D], &|name| member(g, name, f))
+            })
+            .collect())
+    }
+
+    /// Nodes of the given faces, ascending and unique.
+    pub fn nodes_of_faces(&self, faces: &[u32]) -> Vec<u32> {
+        let mut v: Vec<u32> = faces.iter().flat_map(|&f| self.face(f as usize).iter().copied()).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    }
+}
+
+fn member(map: &BTreeMap<String, Vec<u32>>, name: &str, i: u32) -> bool {
+    map.get(name).is_some_and(|v| v.binary_search(&i).is_ok())
+}
+
+fn check_indices(kind: &'static str, name: &str, idx: &[u32], count: usize) -> Result<(), MeshError> {
+    match idx.iter().find(|&&i| i as usize >= count) {
+        Some(&index) => Err(MeshError::BadGroupIndex { kind, name: name.to_string(), index, count }),
+        None => Ok(()),
+    }
+}
+
+fn centroid<D: Dim>(coords: &[f64], nodes: &[u32], c: &mut [f64]) {
+    let d = D::D;
+    c[..d].fill(0.0);
+    for &n in nodes {
+        for k in 0..d {
+            c[k] += coords[n as usize * d + k];
+        }
+    }
+    let inv = 1.0 / nodes.len() as f64;
+    c[..d].iter_mut().for_each(|v| *v *= inv);
+}
+
+fn build_faces<D: Dim>(elements: &[u32]) -> Result<Faces, MeshError> {
+    let (npe, npf, nfe) = (D::NODES_PER_ELEM, D::NODES_PER_FACE, D::FACES_PER_ELEM);
+    let n_elem = elements.len() / npe;
+    let mut map: HashMap<[u32; 3], u32> = HashMap::with_capacity(n_elem * nfe);
+    let mut faces = Faces::default();
+    for (e, conn) in elements.chunks_exact(npe).enumerate() {
+        for f in 0..nfe {
+            let ln = D::face_local_nodes(f);
+            let mut key = [u32::MAX; 3];
+            for (k, &l) in ln.iter().enumerate() {
+                key[k] = conn[l];
+            }
+            key[..npf].sort_unstable();
+            match map.get(&key) {
+                Some(&fi) => {
+                    let fi = fi as usize;
+                    if faces.neighbor[fi] != NO_NEIGHBOR {
+                        return Err(MeshError::NonManifoldFace { nodes: key[..npf].to_vec(), element: e });
+                    }
+                    faces.neighbor[fi] = e as u32;
+                }
+                None => {
+                    map.insert(key, faces.owner.len() as u32);
+                    faces.nodes.extend(ln.iter().map(|&l| conn[l]));
+                    faces.owner.push(e as u32);
+                    faces.owner_local.push(f as u8);
+                    faces.neighbor.push(NO_NEIGHBOR);
+                }
+            }
+        }
+    }
+    faces.boundary = (0..faces.owner.len() as u32)
+        .filter(|&f| faces.neighbor[f as usize] == NO_NEIGHBOR)
+        .collect();
+    Ok(faces)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Dim2, Dim3};
+
+    fn square() -> Mesh<Dim2> {
+        // Unit square cut on the diagonal.
+        Mesh::new(vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0], vec![0, 1, 2, 0, 2, 3]).unwrap()
+    }
+
+    #[test]
+    fn faces_and_boundary() {
+        let m = square();
+        assert_eq!(m.faces().len(), 5);
+        assert_eq!(m.faces().boundary.len(), 4);
+        let total: f64 = (0..m.n_elements()).map(|e| m.element_measure(e)).sum();
+        assert!((total - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn inverted_triangle_is_an_error_naming_the_element() {
+        let err = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0], vec![0, 1, 2, 0, 3, 2])
+            .unwrap_err();
+        assert!(matches!(err, MeshError::InvertedElement { element: 1, .. }), "{err}");
+        assert!(err.to_string().contains("element 1"));
+        let fixed = Mesh::<Dim2>::new_reoriented(vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0], vec![0, 1, 2, 0, 3, 2]).unwrap();
+        assert!(fixed.element_measure(1) > 0.0);
+    }
+
+    #[test]
+    fn degenerate_bad_index_dangling() {
+        let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, 0.0, 2.0, 0.0], vec![0, 1, 2]).unwrap_err();
+        assert!(matches!(e, MeshError::DegenerateElement { element: 0, .. }));
+        let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0], vec![0, 1, 7]).unwrap_err();
+        assert!(matches!(e, MeshError::BadNodeIndex { element: 0, node: 7, .. }));
+        let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 5.0, 5.0], vec![0, 1, 2]).unwrap_err();
+        assert!(matches!(e, MeshError::DanglingNode { node: 3 }));
+        let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, f64::NAN, 0.0, 1.0], vec![0, 1, 2]).unwrap_err();
+        assert!(matches!(e, MeshError::NonFiniteCoordinate { node: 1 }));
+        let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0], vec![0, 1, 2]).unwrap_err();
+        assert!(matches!(e, MeshError::CoordLength { .. }));
+    }
+
+    #[test]
+    fn tet_mesh_faces() {
+        let coords = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        let m = Mesh::<Dim3>::new_reoriented(coords, vec![0, 1, 2, 3, 1, 2, 3, 4]).unwrap();
+        assert_eq!(m.faces().len(), 7);
+        assert_eq!(m.faces().boundary.len(), 6);
+        assert!(m.element_measure(1) > 0.0);
+    }
+
+    #[test]
+    fn ranges_select() {
+        let mut m = square();
+        let left = m.select_nodes(&Range::plane([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], 1e-9)).unwrap();
+        assert_eq!(left, vec![0, 3]);
+        m.add_node_group("left", left).unwrap();
+        let sel = m.select_nodes(&Range::group("left").or(Range::Ball { center: [1.0, 1.0, 0.0], radius: 0.1 })).unwrap();
+        assert_eq!(sel, vec![0, 2, 3]);
+        let top = m.select_boundary_faces(&Range::rect(-1.0, 0.9, 2.0, 1.1)).unwrap();
+        assert_eq!(m.nodes_of_faces(&top), vec![2, 3]);
+        let custom = m.select_elements(&Range::custom(|x| x[0] > x[1])).unwrap();
+        assert_eq!(custom, vec![0]);
+        assert!(matches!(m.select_nodes(&Range::group("nope")), Err(MeshError::UnknownGroup { .. })));
+        assert!(m.select_nodes(&Range::plane([0.0; 3], [0.0; 3], 1.0)).is_err());
+        assert!(m.add_node_group("bad", vec![99]).is_err());
+    }
+}

@@ -1,0 +1,13 @@
+//! # pcdc
+//!
+//! Facade of the pcdc-rs SDK for continuum–discontinuum geomechanics by the combined
+//! finite–discrete element method (FDEM): re-exports the crates and holds the PNG
+//! plotting used by the validation scenes.
+
+#![warn(missing_docs)]
+
+pub use pcdc_compute as compute;
+pub use pcdc_mech as mech;
+pub use pcdc_mesh as mesh;
+
+pub mod plot;
