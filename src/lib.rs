@@ -11,3 +11,5 @@ pub use pcdc_mech as mech;
 pub use pcdc_mesh as mesh;
 
 pub mod plot;
+pub mod report;
+pub mod scenes;

@@ -26,6 +26,7 @@ use plotters::style::{register_font, FontStyle};
 
 /// Errors produced while validating or rendering a [`Plot`].
 #[derive(Debug, thiserror::Error)]
+#[allow(missing_docs)] // variant fields are named after what they hold
 pub enum PlotError {
     /// The plot has no series at all.
     #[error("plot has no series")]

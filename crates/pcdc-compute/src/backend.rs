@@ -58,7 +58,11 @@ impl CpuBackend {
                 .ok()
                 .and_then(|s| s.parse::<usize>().ok())
                 .filter(|&t| t > 0)
-                .unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1))
+                .unwrap_or_else(|| {
+                    std::thread::available_parallelism()
+                        .map(|n| n.get())
+                        .unwrap_or(1)
+                })
         } else {
             threads
         };
@@ -67,7 +71,10 @@ impl CpuBackend {
             .thread_name(|i| format!("pcdc-cpu-{i}"))
             .build()
             .map_err(|e| ComputeError::param("threads", threads, e.to_string()))?;
-        Ok(CpuBackend { pool: Arc::new(pool), threads })
+        Ok(CpuBackend {
+            pool: Arc::new(pool),
+            threads,
+        })
     }
 
     /// Runs `f` inside this backend's thread pool (rayon parallel iterators used in `f`

@@ -6,7 +6,11 @@
 pub enum ComputeError {
     /// A parameter has an invalid value.
     #[error("invalid parameter {name} = {value}: {reason}")]
-    InvalidParameter { name: String, value: String, reason: String },
+    InvalidParameter {
+        name: String,
+        value: String,
+        reason: String,
+    },
     /// A time table is empty, unsorted or holds a non-finite value.
     #[error("table {name}: {reason}")]
     InvalidTable { name: String, reason: String },
@@ -21,7 +25,13 @@ pub enum ComputeError {
     UnknownField(String, String),
     /// The run diverged: NaN, infinity or runaway displacement.
     #[error("divergence at step {step} (t = {time:e} s): {what} at {entity}. Hint: {hint}")]
-    Diverged { step: u64, time: f64, what: String, entity: String, hint: String },
+    Diverged {
+        step: u64,
+        time: f64,
+        what: String,
+        entity: String,
+        hint: String,
+    },
     /// No physics limits the time step and none was given.
     #[error("no stable time step: no composed physics reports one; set it with SimulationBuilder::time_step")]
     NoTimeStep,
@@ -39,7 +49,11 @@ pub enum ComputeError {
     SnapshotMismatch(String),
     /// An input/output error, with the path.
     #[error("{path}: {source}")]
-    Io { path: String, #[source] source: std::io::Error },
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
     /// Snapshot (de)serialisation failed.
     #[error("snapshot encoding: {0}")]
     Encoding(String),
@@ -51,11 +65,18 @@ pub enum ComputeError {
 impl ComputeError {
     /// Shorthand for [`ComputeError::InvalidParameter`].
     pub fn param(name: impl Into<String>, value: impl ToString, reason: impl Into<String>) -> Self {
-        ComputeError::InvalidParameter { name: name.into(), value: value.to_string(), reason: reason.into() }
+        ComputeError::InvalidParameter {
+            name: name.into(),
+            value: value.to_string(),
+            reason: reason.into(),
+        }
     }
 
     /// Shorthand for [`ComputeError::Physics`].
     pub fn physics(physics: impl Into<String>, message: impl Into<String>) -> Self {
-        ComputeError::Physics { physics: physics.into(), message: message.into() }
+        ComputeError::Physics {
+            physics: physics.into(),
+            message: message.into(),
+        }
     }
 }

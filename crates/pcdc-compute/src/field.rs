@@ -49,7 +49,12 @@ pub struct FieldSpec {
 impl FieldSpec {
     /// A field declaration.
     pub fn new(name: &str, location: Location, components: usize) -> Self {
-        FieldSpec { name: name.to_string(), location, components, initial: 0.0 }
+        FieldSpec {
+            name: name.to_string(),
+            location,
+            components,
+            initial: 0.0,
+        }
     }
 }
 
@@ -86,9 +91,20 @@ impl FieldStore {
 
     /// The handle of a declared field.
     pub fn id(&self, name: &str) -> Result<FieldId, ComputeError> {
-        self.specs.iter().position(|s| s.name == name).map(FieldId).ok_or_else(|| {
-            ComputeError::UnknownField(name.to_string(), self.specs.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", "))
-        })
+        self.specs
+            .iter()
+            .position(|s| s.name == name)
+            .map(FieldId)
+            .ok_or_else(|| {
+                ComputeError::UnknownField(
+                    name.to_string(),
+                    self.specs
+                        .iter()
+                        .map(|s| s.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                )
+            })
     }
 
     /// Declaration of a field.

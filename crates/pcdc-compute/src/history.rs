@@ -50,7 +50,10 @@ pub struct History<D: Dim, B: Backend> {
 
 impl<D: Dim, B: Backend> Default for History<D, B> {
     fn default() -> Self {
-        History { columns: Vec::new(), rows: Vec::new() }
+        History {
+            columns: Vec::new(),
+            rows: Vec::new(),
+        }
     }
 }
 
@@ -72,7 +75,11 @@ impl<D: Dim, B: Backend> History<D, B> {
             match p {
                 Probe::NodeDisplacement { node, comp } | Probe::NodeVelocity { node, comp } => {
                     if *node as usize >= sim.mesh().n_nodes() || *comp >= D::D {
-                        return Err(ComputeError::param(format!("probe '{name}'"), format!("node {node} comp {comp}"), "out of range"));
+                        return Err(ComputeError::param(
+                            format!("probe '{name}'"),
+                            format!("node {node} comp {comp}"),
+                            "out of range",
+                        ));
                     }
                 }
                 Probe::Field { field, index, comp } => {
@@ -80,7 +87,14 @@ impl<D: Dim, B: Backend> History<D, B> {
                     let spec = sim.state.fields.spec(id);
                     let n = sim.state.fields.get(id).len() / spec.components.max(1);
                     if *index as usize >= n || *comp >= spec.components {
-                        return Err(ComputeError::param(format!("probe '{name}'"), format!("index {index} comp {comp}"), format!("field '{field}' has {n} entities x {} components", spec.components)));
+                        return Err(ComputeError::param(
+                            format!("probe '{name}'"),
+                            format!("index {index} comp {comp}"),
+                            format!(
+                                "field '{field}' has {n} entities x {} components",
+                                spec.components
+                            ),
+                        ));
                     }
                 }
                 _ => {}
@@ -130,7 +144,10 @@ impl<D: Dim, B: Backend> History<D, B> {
     /// Writes the history as CSV (creating parent directories).
     pub fn write_csv(&self, path: impl AsRef<Path>) -> Result<(), ComputeError> {
         let path = path.as_ref();
-        let io = |source| ComputeError::Io { path: path.display().to_string(), source };
+        let io = |source| ComputeError::Io {
+            path: path.display().to_string(),
+            source,
+        };
         if let Some(dir) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(io)?;
         }

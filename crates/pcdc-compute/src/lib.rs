@@ -26,7 +26,10 @@ pub use backend::{Backend, BackendKind, CpuBackend};
 pub use error::ComputeError;
 pub use field::{names, FieldId, FieldSpec, FieldStore, Location};
 pub use history::{History, Probe};
-pub use physics::{DofConstraint, ForceContext, InitContext, Kinematics, Physics, SlotBlock, StableStep, VelocityContext};
+pub use physics::{
+    DofConstraint, ForceContext, InitContext, Kinematics, Physics, SlotBlock, StableStep,
+    VelocityContext,
+};
 pub use simulation::{Simulation, SimulationBuilder, State, DEFAULT_SAFETY};
 pub use statics::{StaticOptions, StaticReport};
 pub use table::{Table, TimeValue};

@@ -72,11 +72,18 @@ impl<D: Dim> InitContext<'_, D> {
     pub fn register_slots(&mut self, nodes: &[u32]) -> Result<SlotBlock, ComputeError> {
         let n = self.mesh.n_nodes() as u32;
         if let Some(&bad) = nodes.iter().find(|&&x| x >= n) {
-            return Err(ComputeError::param("slot node", bad, format!("mesh has {n} nodes")));
+            return Err(ComputeError::param(
+                "slot node",
+                bad,
+                format!("mesh has {n} nodes"),
+            ));
         }
         let first = self.slot_nodes.len();
         self.slot_nodes.extend_from_slice(nodes);
-        Ok(SlotBlock { first, len: nodes.len() })
+        Ok(SlotBlock {
+            first,
+            len: nodes.len(),
+        })
     }
 }
 
@@ -143,7 +150,14 @@ pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
     /// With `scale_to_dt = Some(dt)` the mass of each contributing entity is scaled up
     /// where needed so that the entity is stable at `dt` (mass scaling for static
     /// relaxation).
-    fn add_mass(&self, _mesh: &Mesh<D>, _fields: &FieldStore, _mass: &mut [f64], _scale_to_dt: Option<f64>) {}
+    fn add_mass(
+        &self,
+        _mesh: &Mesh<D>,
+        _fields: &FieldStore,
+        _mass: &mut [f64],
+        _scale_to_dt: Option<f64>,
+    ) {
+    }
 
     /// The smallest critical time step of this physics' entities, with the entity.
     fn stable_step(&self, _kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
@@ -160,8 +174,16 @@ pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
     /// Adds the linear (small-displacement) stiffness of this physics as triplets
     /// `(row dof, col dof, value)`, dof = node * D + component, for the direct static
     /// solve. `Ok(false)` means the physics has no stiffness; the default refuses.
-    fn linear_stiffness(&self, _mesh: &Mesh<D>, _fields: &FieldStore, _triplets: &mut Vec<(usize, usize, f64)>) -> Result<bool, ComputeError> {
-        Err(ComputeError::NotLinear(format!("physics '{}' has no linear stiffness", self.name())))
+    fn linear_stiffness(
+        &self,
+        _mesh: &Mesh<D>,
+        _fields: &FieldStore,
+        _triplets: &mut Vec<(usize, usize, f64)>,
+    ) -> Result<bool, ComputeError> {
+        Err(ComputeError::NotLinear(format!(
+            "physics '{}' has no linear stiffness",
+            self.name()
+        )))
     }
 
     /// Kinematic constraints for the direct static solve.

@@ -48,7 +48,16 @@ pub struct SimulationBuilder<D: Dim, B: Backend = CpuBackend> {
 impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
     /// Starts a builder on `mesh` run by `backend`.
     pub fn new(mesh: Mesh<D>, backend: B) -> Self {
-        SimulationBuilder { mesh, backend, physics: Vec::new(), gravity: [0.0; 3], safety: DEFAULT_SAFETY, fixed_dt: None, runaway: None, local_damping: 0.0 }
+        SimulationBuilder {
+            mesh,
+            backend,
+            physics: Vec::new(),
+            gravity: [0.0; 3],
+            safety: DEFAULT_SAFETY,
+            fixed_dt: None,
+            runaway: None,
+            local_damping: 0.0,
+        }
     }
 
     /// Adds a physics. Physics run in the order they are added (this fixes the
@@ -100,26 +109,60 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
 
     /// Declares fields, initialises every physics, lumps masses and picks the time step.
     pub fn build(self) -> Result<Simulation<D, B>, ComputeError> {
-        let SimulationBuilder { mesh, backend, mut physics, gravity, safety, fixed_dt, runaway, local_damping } = self;
+        let SimulationBuilder {
+            mesh,
+            backend,
+            mut physics,
+            gravity,
+            safety,
+            fixed_dt,
+            runaway,
+            local_damping,
+        } = self;
         if !(0.0..1.0).contains(&local_damping) {
-            return Err(ComputeError::param("local_damping", local_damping, "must lie in [0, 1)"));
+            return Err(ComputeError::param(
+                "local_damping",
+                local_damping,
+                "must lie in [0, 1)",
+            ));
         }
         if !(safety > 0.0 && safety <= 1.0) {
-            return Err(ComputeError::param("safety_factor", safety, "must lie in (0, 1]"));
+            return Err(ComputeError::param(
+                "safety_factor",
+                safety,
+                "must lie in (0, 1]",
+            ));
         }
         if gravity.iter().any(|g| !g.is_finite()) {
-            return Err(ComputeError::param("gravity", format!("{gravity:?}"), "must be finite"));
+            return Err(ComputeError::param(
+                "gravity",
+                format!("{gravity:?}"),
+                "must be finite",
+            ));
         }
         if let Some(dt) = fixed_dt {
             if !(dt > 0.0 && dt.is_finite()) {
-                return Err(ComputeError::param("time_step", dt, "must be positive and finite"));
+                return Err(ComputeError::param(
+                    "time_step",
+                    dt,
+                    "must be positive and finite",
+                ));
             }
         }
         let (lo, hi) = mesh.bounding_box();
-        let diag = lo.iter().zip(&hi).map(|(a, b)| (b - a).powi(2)).sum::<f64>().sqrt();
+        let diag = lo
+            .iter()
+            .zip(&hi)
+            .map(|(a, b)| (b - a).powi(2))
+            .sum::<f64>()
+            .sqrt();
         let runaway = runaway.unwrap_or(100.0 * diag);
         if !(runaway > 0.0) {
-            return Err(ComputeError::param("runaway_displacement", runaway, "must be positive"));
+            return Err(ComputeError::param(
+                "runaway_displacement",
+                runaway,
+                "must be positive",
+            ));
         }
         let n_nodes = mesh.n_nodes();
         let mut fields = FieldStore::default();
@@ -136,7 +179,11 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
         let mut slot_ranges = Vec::with_capacity(physics.len());
         let mut slot_nodes = Vec::new();
         for p in physics.iter_mut() {
-            let mut ctx = InitContext { mesh: &mesh, fields: &mut fields, slot_nodes: Vec::new() };
+            let mut ctx = InitContext {
+                mesh: &mesh,
+                fields: &mut fields,
+                slot_nodes: Vec::new(),
+            };
             p.init(&mut ctx)?;
             let first = slot_nodes.len();
             slot_nodes.extend_from_slice(&ctx.slot_nodes);
@@ -169,7 +216,13 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
         }
         let d = D::D;
         let mut sim = Simulation {
-            state: State { time: 0.0, step: 0, u: vec![0.0; n_nodes * d], v: vec![0.0; n_nodes * d], fields },
+            state: State {
+                time: 0.0,
+                step: 0,
+                u: vec![0.0; n_nodes * d],
+                v: vec![0.0; n_nodes * d],
+                fields,
+            },
             mass_phys: mass.clone(),
             mass,
             force: vec![0.0; n_nodes * d],
@@ -278,7 +331,15 @@ impl<D: Dim> Simulation<D, CpuBackend> {
         self.slot_forces.fill(0.0);
         for (p, r) in self.physics.iter().zip(&self.slot_ranges) {
             let mut ctx = ForceContext {
-                kin: Kinematics { mesh: &self.mesh, u: kin_u, v: kin_v, time: self.state.time, dt: self.dt, step: self.state.step, damping: self.damping },
+                kin: Kinematics {
+                    mesh: &self.mesh,
+                    u: kin_u,
+                    v: kin_v,
+                    time: self.state.time,
+                    dt: self.dt,
+                    step: self.state.step,
+                    damping: self.damping,
+                },
                 fields,
                 slots: &mut self.slot_forces[r.start * d..r.end * d],
                 backend: &self.backend,
@@ -288,14 +349,18 @@ impl<D: Dim> Simulation<D, CpuBackend> {
         let (ptr, idx, slots) = (&self.gather_ptr, &self.gather_idx, &self.slot_forces);
         let force = &mut self.force;
         self.backend.install(|| {
-            force.par_chunks_mut(d).enumerate().with_min_len(1024).for_each(|(n, f)| {
-                f.fill(0.0);
-                for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
-                    for k in 0..d {
-                        f[k] += slots[s as usize * d + k];
+            force
+                .par_chunks_mut(d)
+                .enumerate()
+                .with_min_len(1024)
+                .for_each(|(n, f)| {
+                    f.fill(0.0);
+                    for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
+                        for k in 0..d {
+                            f[k] += slots[s as usize * d + k];
+                        }
                     }
-                }
-            })
+                })
         });
         if !gross {
             return Ok(None);
@@ -321,21 +386,31 @@ impl<D: Dim> Simulation<D, CpuBackend> {
         let (force, mass, mass_phys) = (&self.force, &self.mass, &self.mass_phys);
         let v = &mut self.state.v;
         self.backend.install(|| {
-            v.par_chunks_mut(d).enumerate().with_min_len(1024).for_each(|(n, vn)| {
-                let (m, w) = (mass[n], mass_phys[n] / mass[n]);
-                for k in 0..d {
-                    let mut f = force[n * d + k] + w * m * g[k];
-                    if alpha > 0.0 {
-                        // Local non-viscous damping (Cundall): f -= α |f| sign(v).
-                        f -= alpha * f.abs() * vn[k].signum() * (vn[k] != 0.0) as u8 as f64;
+            v.par_chunks_mut(d)
+                .enumerate()
+                .with_min_len(1024)
+                .for_each(|(n, vn)| {
+                    let (m, w) = (mass[n], mass_phys[n] / mass[n]);
+                    for k in 0..d {
+                        let mut f = force[n * d + k] + w * m * g[k];
+                        if alpha > 0.0 {
+                            // Local non-viscous damping (Cundall): f -= α |f| sign(v).
+                            f -= alpha * f.abs() * vn[k].signum() * (vn[k] != 0.0) as u8 as f64;
+                        }
+                        vn[k] += dt * f / m;
                     }
-                    vn[k] += dt * f / m;
-                }
-            })
+                })
         });
         let t_end = self.state.time + dt;
         for p in &self.physics {
-            let mut ctx = VelocityContext { mesh: &self.mesh, u: &self.state.u, v: &mut self.state.v, time: t_end, dt, fields: &mut self.state.fields };
+            let mut ctx = VelocityContext {
+                mesh: &self.mesh,
+                u: &self.state.u,
+                v: &mut self.state.v,
+                time: t_end,
+                dt,
+                fields: &mut self.state.fields,
+            };
             p.apply_kinematics(&mut ctx);
         }
         let limit2 = self.runaway * self.runaway;
@@ -378,7 +453,13 @@ impl<D: Dim> Simulation<D, CpuBackend> {
             } else {
                 format!("runaway displacement above {:e} m", self.runaway)
             };
-            return Err(ComputeError::Diverged { step: self.state.step, time: self.state.time, what, entity: format!("node {n}"), hint });
+            return Err(ComputeError::Diverged {
+                step: self.state.step,
+                time: self.state.time,
+                what,
+                entity: format!("node {n}"),
+                hint,
+            });
         }
         Ok(())
     }
@@ -387,7 +468,10 @@ impl<D: Dim> Simulation<D, CpuBackend> {
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), ComputeError> {
         let path = path.as_ref();
         let bytes = self.snapshot_bytes()?;
-        std::fs::write(path, bytes).map_err(|source| ComputeError::Io { path: path.display().to_string(), source })
+        std::fs::write(path, bytes).map_err(|source| ComputeError::Io {
+            path: path.display().to_string(),
+            source,
+        })
     }
 
     /// Encodes the running state.
@@ -409,18 +493,25 @@ impl<D: Dim> Simulation<D, CpuBackend> {
     /// bit for bit.
     pub fn restore(&mut self, path: impl AsRef<Path>) -> Result<(), ComputeError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|source| ComputeError::Io { path: path.display().to_string(), source })?;
+        let bytes = std::fs::read(path).map_err(|source| ComputeError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
         self.restore_bytes(&bytes)
     }
 
     /// Restores from bytes made by [`Simulation::snapshot_bytes`].
     pub fn restore_bytes(&mut self, bytes: &[u8]) -> Result<(), ComputeError> {
-        let snap: Snapshot = postcard::from_bytes(bytes).map_err(|e| ComputeError::Encoding(e.to_string()))?;
+        let snap: Snapshot =
+            postcard::from_bytes(bytes).map_err(|e| ComputeError::Encoding(e.to_string()))?;
         let mismatch = |what: String| Err(ComputeError::SnapshotMismatch(what));
         if snap.magic != SNAPSHOT_MAGIC {
             return mismatch(format!("not a pcdc snapshot (header '{}')", snap.magic));
         }
-        if snap.dim != D::NAME || snap.n_nodes != self.mesh.n_nodes() || snap.n_elements != self.mesh.n_elements() {
+        if snap.dim != D::NAME
+            || snap.n_nodes != self.mesh.n_nodes()
+            || snap.n_elements != self.mesh.n_elements()
+        {
             return mismatch(format!(
                 "snapshot is {} with {} nodes and {} elements; simulation is {} with {} nodes and {} elements",
                 snap.dim, snap.n_nodes, snap.n_elements, D::NAME, self.mesh.n_nodes(), self.mesh.n_elements()
@@ -428,7 +519,10 @@ impl<D: Dim> Simulation<D, CpuBackend> {
         }
         let names: Vec<String> = self.physics.iter().map(|p| p.name().to_string()).collect();
         if snap.physics != names {
-            return mismatch(format!("snapshot physics {:?}, simulation physics {:?}", snap.physics, names));
+            return mismatch(format!(
+                "snapshot physics {:?}, simulation physics {:?}",
+                snap.physics, names
+            ));
         }
         if snap.state.fields.specs() != self.state.fields.specs() {
             return mismatch("field layouts differ".to_string());
@@ -464,7 +558,11 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
     /// [`SimulationBuilder::local_damping`]).
     pub fn set_local_damping(&mut self, alpha: f64) -> Result<(), ComputeError> {
         if !(0.0..1.0).contains(&alpha) {
-            return Err(ComputeError::param("local_damping", alpha, "must lie in [0, 1)"));
+            return Err(ComputeError::param(
+                "local_damping",
+                alpha,
+                "must lie in [0, 1)",
+            ));
         }
         self.local_damping = alpha;
         Ok(())
@@ -478,7 +576,15 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
     /// Recomputes the stable time step from the current state (e.g. after large
     /// deformation) unless a fixed step was set.
     pub fn update_time_step(&mut self) -> Result<(), ComputeError> {
-        let kin = Kinematics { mesh: &self.mesh, u: &self.state.u, v: &self.state.v, time: self.state.time, dt: self.dt, step: self.state.step, damping: self.damping };
+        let kin = Kinematics {
+            mesh: &self.mesh,
+            u: &self.state.u,
+            v: &self.state.v,
+            time: self.state.time,
+            dt: self.dt,
+            step: self.state.step,
+            damping: self.damping,
+        };
         let mut best: Option<StableStep> = None;
         for p in &self.physics {
             if let Some(s) = p.stable_step(&kin, &self.state.fields) {
@@ -509,18 +615,40 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
     /// Kinetic energy ½ Σ m v² (J) with the half-step velocities.
     pub fn kinetic_energy(&self) -> f64 {
         let d = D::D;
-        0.5 * self.state.v.chunks_exact(d).zip(&self.mass_phys).map(|(v, m)| m * v.iter().map(|x| x * x).sum::<f64>()).sum::<f64>()
+        0.5 * self
+            .state
+            .v
+            .chunks_exact(d)
+            .zip(&self.mass_phys)
+            .map(|(v, m)| m * v.iter().map(|x| x * x).sum::<f64>())
+            .sum::<f64>()
     }
 
     /// Energy stored by all physics (J), e.g. elastic strain energy.
     pub fn stored_energy(&self) -> f64 {
-        let kin = Kinematics { mesh: &self.mesh, u: &self.state.u, v: &self.state.v, time: self.state.time, dt: self.dt, step: self.state.step, damping: self.damping };
-        self.physics.iter().map(|p| p.stored_energy(&kin, &self.state.fields)).sum()
+        let kin = Kinematics {
+            mesh: &self.mesh,
+            u: &self.state.u,
+            v: &self.state.v,
+            time: self.state.time,
+            dt: self.dt,
+            step: self.state.step,
+            damping: self.damping,
+        };
+        self.physics
+            .iter()
+            .map(|p| p.stored_energy(&kin, &self.state.fields))
+            .sum()
     }
 
     /// Current position of every node (m), stride D.
     pub fn positions(&self) -> Vec<f64> {
-        self.mesh.coords().iter().zip(&self.state.u).map(|(x, u)| x + u).collect()
+        self.mesh
+            .coords()
+            .iter()
+            .zip(&self.state.u)
+            .map(|(x, u)| x + u)
+            .collect()
     }
 
     /// Values of a field by name.
@@ -536,7 +664,11 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
 
     /// Bytes held by the state, masses and force slots (memory footprint of the run).
     pub fn state_bytes(&self) -> usize {
-        8 * (self.state.u.len() + self.state.v.len() + self.mass.len() * 2 + self.force.len() + self.slot_forces.len())
+        8 * (self.state.u.len()
+            + self.state.v.len()
+            + self.mass.len() * 2
+            + self.force.len()
+            + self.slot_forces.len())
             + 4 * (self.gather_idx.len() + self.gather_ptr.len())
             + self.state.fields.bytes()
     }

@@ -36,7 +36,11 @@ pub struct StaticOptions {
 
 impl Default for StaticOptions {
     fn default() -> Self {
-        StaticOptions { tolerance: 1e-6, max_steps: 200_000, check_every: 20 }
+        StaticOptions {
+            tolerance: 1e-6,
+            max_steps: 200_000,
+            check_every: 20,
+        }
     }
 }
 
@@ -60,7 +64,11 @@ impl<D: Dim> Simulation<D, CpuBackend> {
                 den += g * g;
             }
         }
-        Ok(if den > 0.0 { (num / den).sqrt() } else { num.sqrt() })
+        Ok(if den > 0.0 {
+            (num / den).sqrt()
+        } else {
+            num.sqrt()
+        })
     }
 
     /// Dofs left free by the kinematic conditions: a dof counts as constrained when the
@@ -70,7 +78,14 @@ impl<D: Dim> Simulation<D, CpuBackend> {
         let mut v = vec![probe_value; self.state.v.len()];
         let mut fields = self.state.fields.clone();
         for p in &self.physics {
-            let mut ctx = crate::physics::VelocityContext { mesh: &self.mesh, u: &self.state.u, v: &mut v, time: self.state.time, dt: self.dt, fields: &mut fields };
+            let mut ctx = crate::physics::VelocityContext {
+                mesh: &self.mesh,
+                u: &self.state.u,
+                v: &mut v,
+                time: self.state.time,
+                dt: self.dt,
+                fields: &mut fields,
+            };
             p.apply_kinematics(&mut ctx);
         }
         v.iter().map(|&x| x == probe_value).collect()
@@ -105,7 +120,11 @@ impl<D: Dim> Simulation<D, CpuBackend> {
         result
     }
 
-    fn relax_loop(&mut self, opts: &StaticOptions, free: &[bool]) -> Result<StaticReport, ComputeError> {
+    fn relax_loop(
+        &mut self,
+        opts: &StaticOptions,
+        free: &[bool],
+    ) -> Result<StaticReport, ComputeError> {
         let mut ratio = f64::INFINITY;
         for it in 1..=opts.max_steps {
             self.compute_forces(false)?;
@@ -117,7 +136,11 @@ impl<D: Dim> Simulation<D, CpuBackend> {
                 }
             }
         }
-        Err(ComputeError::NotConverged { steps: opts.max_steps, ratio, tol: opts.tolerance })
+        Err(ComputeError::NotConverged {
+            steps: opts.max_steps,
+            ratio,
+            tol: opts.tolerance,
+        })
     }
 
     /// Solves the static problem directly with a sparse Cholesky factorisation of the
@@ -155,7 +178,10 @@ impl<D: Dim> Simulation<D, CpuBackend> {
             }
         }
         if nfree == 0 {
-            return Ok(StaticReport { steps: 0, ratio: 0.0 });
+            return Ok(StaticReport {
+                steps: 0,
+                ratio: 0.0,
+            });
         }
         // Lower triangle of the reduced stiffness, duplicates summed.
         let mut lower: Vec<(usize, usize, f64)> = trip
@@ -173,13 +199,20 @@ impl<D: Dim> Simulation<D, CpuBackend> {
                 _ => merged.push(Triplet::new(r, c, v)),
             }
         }
-        let k = SparseColMat::<usize, f64>::try_new_from_triplets(nfree, nfree, &merged).map_err(|e| ComputeError::Solver(format!("{e:?}")))?;
-        let llt = k.sp_cholesky(faer::Side::Lower).map_err(|e| ComputeError::Solver(format!("Cholesky factorisation failed ({e:?})")))?;
+        let k = SparseColMat::<usize, f64>::try_new_from_triplets(nfree, nfree, &merged)
+            .map_err(|e| ComputeError::Solver(format!("{e:?}")))?;
+        let llt = k
+            .sp_cholesky(faer::Side::Lower)
+            .map_err(|e| ComputeError::Solver(format!("Cholesky factorisation failed ({e:?})")))?;
         self.state.v.fill(0.0);
         let saved_damping = self.damping;
         self.damping = false;
         let mut ratio = f64::INFINITY;
-        let mut result = Err(ComputeError::NotConverged { steps: opts.max_steps, ratio, tol: opts.tolerance });
+        let mut result = Err(ComputeError::NotConverged {
+            steps: opts.max_steps,
+            ratio,
+            tol: opts.tolerance,
+        });
         for it in 1..=opts.max_steps {
             self.compute_forces(false)?;
             let mut rhs = faer::Mat::<f64>::from_fn(nfree, 1, |i, _| 0.0 * i as f64);
@@ -203,7 +236,11 @@ impl<D: Dim> Simulation<D, CpuBackend> {
                 result = Ok(StaticReport { steps: it, ratio });
                 break;
             }
-            result = Err(ComputeError::NotConverged { steps: it, ratio, tol: opts.tolerance });
+            result = Err(ComputeError::NotConverged {
+                steps: it,
+                ratio,
+                tol: opts.tolerance,
+            });
         }
         self.damping = saved_damping;
         result
@@ -212,10 +249,18 @@ impl<D: Dim> Simulation<D, CpuBackend> {
 
 fn check_opts(opts: &StaticOptions) -> Result<(), ComputeError> {
     if !(opts.tolerance > 0.0) {
-        return Err(ComputeError::param("tolerance", opts.tolerance, "must be positive"));
+        return Err(ComputeError::param(
+            "tolerance",
+            opts.tolerance,
+            "must be positive",
+        ));
     }
     if opts.max_steps == 0 || opts.check_every == 0 {
-        return Err(ComputeError::param("max_steps/check_every", opts.max_steps.min(opts.check_every), "must be at least 1"));
+        return Err(ComputeError::param(
+            "max_steps/check_every",
+            opts.max_steps.min(opts.check_every),
+            "must be at least 1",
+        ));
     }
     Ok(())
 }

@@ -16,9 +16,14 @@ impl Table {
     /// Builds a table from `(time [s], value)` points. Errors on an empty table, a
     /// non-finite entry, or times that are not strictly increasing (naming the entry).
     pub fn new(name: &str, points: &[(f64, f64)]) -> Result<Self, ComputeError> {
-        let err = |reason: String| ComputeError::InvalidTable { name: name.to_string(), reason };
+        let err = |reason: String| ComputeError::InvalidTable {
+            name: name.to_string(),
+            reason,
+        };
         if points.is_empty() {
-            return Err(err("empty table: give at least one (time, value) point".into()));
+            return Err(err(
+                "empty table: give at least one (time, value) point".into()
+            ));
         }
         for (i, &(t, v)) in points.iter().enumerate() {
             if !t.is_finite() || !v.is_finite() {
@@ -31,7 +36,10 @@ impl Table {
                 )));
             }
         }
-        Ok(Table { t: points.iter().map(|p| p.0).collect(), v: points.iter().map(|p| p.1).collect() })
+        Ok(Table {
+            t: points.iter().map(|p| p.0).collect(),
+            v: points.iter().map(|p| p.1).collect(),
+        })
     }
 
     /// Value at time `t` (s): linear between points, constant outside.
@@ -75,7 +83,9 @@ impl TimeValue {
     /// Errors when a constant is not finite.
     pub fn check(&self, name: &str) -> Result<(), ComputeError> {
         match self {
-            TimeValue::Const(c) if !c.is_finite() => Err(ComputeError::param(name, c, "must be finite")),
+            TimeValue::Const(c) if !c.is_finite() => {
+                Err(ComputeError::param(name, c, "must be finite"))
+            }
             _ => Ok(()),
         }
     }
@@ -100,7 +110,10 @@ mod tests {
 
     #[test]
     fn errors() {
-        assert!(matches!(Table::new("v", &[]), Err(ComputeError::InvalidTable { .. })));
+        assert!(matches!(
+            Table::new("v", &[]),
+            Err(ComputeError::InvalidTable { .. })
+        ));
         let e = Table::new("vel", &[(0.0, 1.0), (2.0, 1.0), (1.0, 0.0)]).unwrap_err();
         assert!(e.to_string().contains("entry 2"), "{e}");
         assert!(Table::new("v", &[(0.0, f64::NAN)]).is_err());

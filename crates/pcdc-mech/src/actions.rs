@@ -10,9 +10,17 @@ use crate::MechError;
 pub const DISPLACEMENT_RESET: &str = "displacement_reset";
 
 /// Sets the velocity (m/s) of every node in `range` (first `D` components used).
-pub fn set_velocity<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &Range, velocity: [f64; 3]) -> Result<usize, MechError> {
+pub fn set_velocity<D: Dim>(
+    sim: &mut Simulation<D, CpuBackend>,
+    range: &Range,
+    velocity: [f64; 3],
+) -> Result<usize, MechError> {
     if velocity.iter().any(|v| !v.is_finite()) {
-        return Err(MechError::param("velocity", format!("{velocity:?}"), "must be finite"));
+        return Err(MechError::param(
+            "velocity",
+            format!("{velocity:?}"),
+            "must be finite",
+        ));
     }
     let nodes = sim.mesh().select_nodes(range)?;
     let d = D::D;
@@ -23,14 +31,20 @@ pub fn set_velocity<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &Range, 
 }
 
 /// Zeroes the velocity of every node in `range`.
-pub fn reset_velocity<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &Range) -> Result<usize, MechError> {
+pub fn reset_velocity<D: Dim>(
+    sim: &mut Simulation<D, CpuBackend>,
+    range: &Range,
+) -> Result<usize, MechError> {
     set_velocity(sim, range, [0.0; 3])
 }
 
 /// Resets the reported displacement of the nodes in `range` to zero without moving them:
 /// the current displacement is remembered in the `displacement_reset` field (declared by
 /// [`crate::Mechanics`]) and subtracted by [`crate::output::displacement`].
-pub fn reset_displacement<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &Range) -> Result<usize, MechError> {
+pub fn reset_displacement<D: Dim>(
+    sim: &mut Simulation<D, CpuBackend>,
+    range: &Range,
+) -> Result<usize, MechError> {
     let nodes = sim.mesh().select_nodes(range)?;
     let id = sim.state.fields.id(DISPLACEMENT_RESET)?;
     let d = D::D;
@@ -45,7 +59,10 @@ pub fn reset_displacement<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &R
 
 /// Resets the stress and the constitutive history variables of the elements in `range`
 /// to zero (the current shape becomes stress-free).
-pub fn reset_element_state<D: Dim>(sim: &mut Simulation<D, CpuBackend>, range: &Range) -> Result<usize, MechError> {
+pub fn reset_element_state<D: Dim>(
+    sim: &mut Simulation<D, CpuBackend>,
+    range: &Range,
+) -> Result<usize, MechError> {
     let elems = sim.mesh().select_elements(range)?;
     let fields = &mut sim.state.fields;
     let stress = fields.id(names::STRESS)?;

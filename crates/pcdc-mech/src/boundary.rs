@@ -7,7 +7,10 @@
 //! the face's current outward normal `n`, with `σ = diag(s_xx, s_yy, s_zz) + s_n I`; a
 //! compressive far-field stress or a pressure is therefore negative.
 
-use pcdc_compute::{ComputeError, CpuBackend, DofConstraint, FieldId, FieldSpec, FieldStore, ForceContext, InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext};
+use pcdc_compute::{
+    ComputeError, CpuBackend, DofConstraint, FieldId, FieldSpec, FieldStore, ForceContext,
+    InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext,
+};
 use pcdc_mesh::{Dim, Mesh, Range};
 
 use crate::MechError;
@@ -32,11 +35,26 @@ pub type Components = [Option<TimeValue>; 3];
 
 #[derive(Clone, Debug)]
 enum Item {
-    Velocity { range: Range, values: Components },
-    Acceleration { range: Range, values: Components },
-    NodeForce { range: Range, values: Components },
-    FaceStress { range: Range, stress: FaceStress },
-    Constraint { range: Range, constraint: Constraint },
+    Velocity {
+        range: Range,
+        values: Components,
+    },
+    Acceleration {
+        range: Range,
+        values: Components,
+    },
+    NodeForce {
+        range: Range,
+        values: Components,
+    },
+    FaceStress {
+        range: Range,
+        stress: FaceStress,
+    },
+    Constraint {
+        range: Range,
+        constraint: Constraint,
+    },
 }
 
 /// A stress applied on boundary faces (manual table 6), Pa, tension positive.
@@ -55,12 +73,20 @@ pub struct FaceStress {
 impl FaceStress {
     /// A uniform stress state `diag(xx, yy, zz)` (constants).
     pub fn diagonal(xx: f64, yy: f64, zz: f64) -> Self {
-        FaceStress { xx: Some(xx.into()), yy: Some(yy.into()), zz: Some(zz.into()), normal: None }
+        FaceStress {
+            xx: Some(xx.into()),
+            yy: Some(yy.into()),
+            zz: Some(zz.into()),
+            normal: None,
+        }
     }
 
     /// A normal stress that follows the face (tension positive).
     pub fn normal(s: impl Into<TimeValue>) -> Self {
-        FaceStress { normal: Some(s.into()), ..Default::default() }
+        FaceStress {
+            normal: Some(s.into()),
+            ..Default::default()
+        }
     }
 }
 
@@ -137,7 +163,12 @@ impl Boundary {
                 Item::Acceleration { values, .. } => check(values, "acceleration")?,
                 Item::NodeForce { values, .. } => check(values, "node force")?,
                 Item::FaceStress { stress, .. } => {
-                    for (n, v) in [("xx", &stress.xx), ("yy", &stress.yy), ("zz", &stress.zz), ("normal", &stress.normal)] {
+                    for (n, v) in [
+                        ("xx", &stress.xx),
+                        ("yy", &stress.yy),
+                        ("zz", &stress.zz),
+                        ("normal", &stress.normal),
+                    ] {
                         if let Some(v) = v {
                             v.check(&format!("face stress {n}"))?;
                         }
@@ -147,7 +178,11 @@ impl Boundary {
                     Constraint::Fixed => {}
                     Constraint::Line(d) | Constraint::Plane(d) => {
                         if d.iter().any(|x| !x.is_finite()) || d.iter().all(|x| *x == 0.0) {
-                            return Err(MechError::param("constraint direction", format!("{d:?}"), "must be finite and non-zero"));
+                            return Err(MechError::param(
+                                "constraint direction",
+                                format!("{d:?}"),
+                                "must be finite and non-zero",
+                            ));
                         }
                     }
                 },
@@ -172,7 +207,11 @@ impl<D: Dim> Physics<D, CpuBackend> for Boundary {
     }
 
     fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
-        if self.items.iter().any(|i| matches!(i, Item::Acceleration { .. })) {
+        if self
+            .items
+            .iter()
+            .any(|i| matches!(i, Item::Acceleration { .. }))
+        {
             vec![FieldSpec::new(ACCEL_VELOCITY, Location::Node, D::D)]
         } else {
             Vec::new()
@@ -192,18 +231,36 @@ impl<D: Dim> Physics<D, CpuBackend> for Boundary {
                 Item::FaceStress { range, .. } => (range, "face stress"),
                 Item::Constraint { range, .. } => (range, "constraint"),
             };
-            let mut r = Resolved { nodes: Vec::new(), faces: Vec::new(), slots: None };
+            let mut r = Resolved {
+                nodes: Vec::new(),
+                faces: Vec::new(),
+                slots: None,
+            };
             if let Item::FaceStress { .. } = it {
                 r.faces = mesh.select_boundary_faces(range).map_err(MechError::from)?;
                 if r.faces.is_empty() {
-                    return Err(MechError::EmptyRange { what: format!("boundary condition {i} ({what})"), range: format!("{range:?}"), entity: "boundary face" }.into());
+                    return Err(MechError::EmptyRange {
+                        what: format!("boundary condition {i} ({what})"),
+                        range: format!("{range:?}"),
+                        entity: "boundary face",
+                    }
+                    .into());
                 }
-                let nodes: Vec<u32> = r.faces.iter().flat_map(|&f| mesh.face(f as usize).iter().copied()).collect();
+                let nodes: Vec<u32> = r
+                    .faces
+                    .iter()
+                    .flat_map(|&f| mesh.face(f as usize).iter().copied())
+                    .collect();
                 r.slots = Some(ctx.register_slots(&nodes)?);
             } else {
                 r.nodes = mesh.select_nodes(range).map_err(MechError::from)?;
                 if r.nodes.is_empty() {
-                    return Err(MechError::EmptyRange { what: format!("boundary condition {i} ({what})"), range: format!("{range:?}"), entity: "node" }.into());
+                    return Err(MechError::EmptyRange {
+                        what: format!("boundary condition {i} ({what})"),
+                        range: format!("{range:?}"),
+                        entity: "node",
+                    }
+                    .into());
                 }
                 if let Item::NodeForce { .. } = it {
                     r.slots = Some(ctx.register_slots(&r.nodes)?);
@@ -214,21 +271,31 @@ impl<D: Dim> Physics<D, CpuBackend> for Boundary {
         Ok(())
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, CpuBackend>) -> Result<(), ComputeError> {
+    fn compute_forces(
+        &self,
+        ctx: &mut ForceContext<'_, D, CpuBackend>,
+    ) -> Result<(), ComputeError> {
         let d = D::D;
         let t = ctx.kin.time;
         for (it, r) in self.items.iter().zip(&self.resolved) {
             match it {
                 Item::NodeForce { values, .. } => {
                     let block = r.slots.expect("slots registered");
-                    let f: Vec<f64> = (0..d).map(|k| values[k].as_ref().map_or(0.0, |v| v.at(t))).collect();
+                    let f: Vec<f64> = (0..d)
+                        .map(|k| values[k].as_ref().map_or(0.0, |v| v.at(t)))
+                        .collect();
                     for s in 0..block.len {
-                        ctx.slots[(block.first + s) * d..(block.first + s + 1) * d].copy_from_slice(&f);
+                        ctx.slots[(block.first + s) * d..(block.first + s + 1) * d]
+                            .copy_from_slice(&f);
                     }
                 }
                 Item::FaceStress { stress, .. } => {
                     let block = r.slots.expect("slots registered");
-                    let diag = [stress.xx.as_ref().map_or(0.0, |v| v.at(t)), stress.yy.as_ref().map_or(0.0, |v| v.at(t)), stress.zz.as_ref().map_or(0.0, |v| v.at(t))];
+                    let diag = [
+                        stress.xx.as_ref().map_or(0.0, |v| v.at(t)),
+                        stress.yy.as_ref().map_or(0.0, |v| v.at(t)),
+                        stress.zz.as_ref().map_or(0.0, |v| v.at(t)),
+                    ];
                     let sn = stress.normal.as_ref().map_or(0.0, |v| v.at(t));
                     let npf = D::NODES_PER_FACE;
                     let mut x = [0.0; 9];
@@ -311,7 +378,12 @@ impl<D: Dim> Physics<D, CpuBackend> for Boundary {
         }
     }
 
-    fn linear_stiffness(&self, _mesh: &Mesh<D>, _fields: &FieldStore, _t: &mut Vec<(usize, usize, f64)>) -> Result<bool, ComputeError> {
+    fn linear_stiffness(
+        &self,
+        _mesh: &Mesh<D>,
+        _fields: &FieldStore,
+        _t: &mut Vec<(usize, usize, f64)>,
+    ) -> Result<bool, ComputeError> {
         Ok(false)
     }
 
@@ -319,7 +391,9 @@ impl<D: Dim> Physics<D, CpuBackend> for Boundary {
         let d = D::D;
         for (it, r) in self.items.iter().zip(&self.resolved) {
             let comps: Vec<usize> = match it {
-                Item::Velocity { values, .. } | Item::Acceleration { values, .. } => (0..d).filter(|&k| values[k].is_some()).collect(),
+                Item::Velocity { values, .. } | Item::Acceleration { values, .. } => {
+                    (0..d).filter(|&k| values[k].is_some()).collect()
+                }
                 Item::Constraint { constraint, .. } => match constraint {
                     Constraint::Fixed => (0..d).collect(),
                     Constraint::Line(dir) | Constraint::Plane(dir) => {
@@ -329,7 +403,9 @@ impl<D: Dim> Physics<D, CpuBackend> for Boundary {
                             (Some(a), Constraint::Line(_)) => (0..d).filter(|&k| k != a).collect(),
                             (Some(a), Constraint::Plane(_)) => vec![a],
                             _ => {
-                                out.extend(r.nodes.iter().map(|&node| DofConstraint::Oblique { node }));
+                                out.extend(
+                                    r.nodes.iter().map(|&node| DofConstraint::Oblique { node }),
+                                );
                                 continue;
                             }
                         }

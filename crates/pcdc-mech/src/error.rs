@@ -6,10 +6,18 @@
 pub enum MechError {
     /// A material or boundary parameter is invalid.
     #[error("invalid parameter {name} = {value}: {reason}")]
-    InvalidParameter { name: String, value: String, reason: String },
+    InvalidParameter {
+        name: String,
+        value: String,
+        reason: String,
+    },
     /// A range matched nothing where something is required.
     #[error("{what}: the range {range} selects no {entity}")]
-    EmptyRange { what: String, range: String, entity: &'static str },
+    EmptyRange {
+        what: String,
+        range: String,
+        entity: &'static str,
+    },
     /// Mesh-level error.
     #[error(transparent)]
     Mesh(#[from] pcdc_mesh::MeshError),
@@ -21,7 +29,11 @@ pub enum MechError {
 impl MechError {
     /// Shorthand for [`MechError::InvalidParameter`].
     pub fn param(name: impl Into<String>, value: impl ToString, reason: impl Into<String>) -> Self {
-        MechError::InvalidParameter { name: name.into(), value: value.to_string(), reason: reason.into() }
+        MechError::InvalidParameter {
+            name: name.into(),
+            value: value.to_string(),
+            reason: reason.into(),
+        }
     }
 }
 

@@ -25,7 +25,8 @@ pub fn polar_2d(f: &[f64; 4]) -> (f64, f64) {
 /// Determinant of a row-major 3x3 matrix.
 #[inline]
 pub fn det3(a: &[f64; 9]) -> f64 {
-    a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) + a[2] * (a[3] * a[7] - a[4] * a[6])
+    a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
+        + a[2] * (a[3] * a[7] - a[4] * a[6])
 }
 
 /// Inverse-transpose of a row-major 3x3 matrix (cofactor matrix over determinant).

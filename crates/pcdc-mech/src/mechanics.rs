@@ -10,7 +10,10 @@
 
 use std::sync::Arc;
 
-use pcdc_compute::{names, ComputeError, CpuBackend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext, Kinematics, Location, Physics, StableStep};
+use pcdc_compute::{
+    names, ComputeError, CpuBackend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
+    Kinematics, Location, Physics, StableStep,
+};
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
@@ -123,7 +126,13 @@ impl Mechanics {
 fn geometry<D: Dim>(mesh: &Mesh<D>) -> ElementGeometry {
     let (d, npe) = (D::D, D::NODES_PER_ELEM);
     let ne = mesh.n_elements();
-    let mut g = ElementGeometry { dm_inv: vec![0.0; ne * d * d], volume: vec![0.0; ne], mean_edge: vec![0.0; ne], height: vec![0.0; ne], dim: d };
+    let mut g = ElementGeometry {
+        dm_inv: vec![0.0; ne * d * d],
+        volume: vec![0.0; ne],
+        mean_edge: vec![0.0; ne],
+        height: vec![0.0; ne],
+        dim: d,
+    };
     let mut x = [0.0; 12];
     for e in 0..ne {
         mesh.element_coords(e, &mut x[..npe * d]);
@@ -133,7 +142,10 @@ fn geometry<D: Dim>(mesh: &Mesh<D>) -> ElementGeometry {
         let mut longest = 0.0f64;
         for a in 0..npe {
             for b in a + 1..npe {
-                let l = (0..d).map(|k| (x[a * d + k] - x[b * d + k]).powi(2)).sum::<f64>().sqrt();
+                let l = (0..d)
+                    .map(|k| (x[a * d + k] - x[b * d + k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
                 sum += l;
                 cnt += 1.0;
                 longest = longest.max(l);
@@ -158,7 +170,17 @@ fn geometry<D: Dim>(mesh: &Mesh<D>) -> ElementGeometry {
                 max_face = max_face.max(D::face_measure_normal(&fx, &mut n));
             }
             g.height[e] = 3.0 * vol / max_face;
-            let m = [x[3] - x[0], x[6] - x[0], x[9] - x[0], x[4] - x[1], x[7] - x[1], x[10] - x[1], x[5] - x[2], x[8] - x[2], x[11] - x[2]];
+            let m = [
+                x[3] - x[0],
+                x[6] - x[0],
+                x[9] - x[0],
+                x[4] - x[1],
+                x[7] - x[1],
+                x[10] - x[1],
+                x[5] - x[2],
+                x[8] - x[2],
+                x[11] - x[2],
+            ];
             let it = crate::kinematics::inv_transpose3(&m);
             // (D_m⁻¹)[j][k] = (D_m⁻ᵀ)[k][j]
             for j in 0..3 {
@@ -183,14 +205,28 @@ struct StepInputs<'a> {
 impl Mechanics {
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn element_2d(&self, e: usize, inp: &StepInputs<'_>, slots: &mut [f64], stress: &mut [f64], strain: &mut [f64], szz: &mut f64, state: &mut [f64]) {
+    fn element_2d(
+        &self,
+        e: usize,
+        inp: &StepInputs<'_>,
+        slots: &mut [f64],
+        stress: &mut [f64],
+        strain: &mut [f64],
+        szz: &mut f64,
+        state: &mut [f64],
+    ) {
         let c = &inp.conn[3 * e..3 * e + 3];
         let (n0, n1, n2) = (c[0] as usize * 2, c[1] as usize * 2, c[2] as usize * 2);
         let p = |n: usize, k: usize| inp.x0[n + k] + inp.u[n + k];
         let (x0, y0) = (p(n0, 0), p(n0, 1));
         let ds = [p(n1, 0) - x0, p(n2, 0) - x0, p(n1, 1) - y0, p(n2, 1) - y0];
         let m = &self.geo.dm_inv[4 * e..4 * e + 4];
-        let f = [ds[0] * m[0] + ds[1] * m[2], ds[0] * m[1] + ds[1] * m[3], ds[2] * m[0] + ds[3] * m[2], ds[2] * m[1] + ds[3] * m[3]];
+        let f = [
+            ds[0] * m[0] + ds[1] * m[2],
+            ds[0] * m[1] + ds[1] * m[3],
+            ds[2] * m[0] + ds[3] * m[2],
+            ds[2] * m[1] + ds[3] * m[3],
+        ];
         let (co, si) = polar_2d(&f);
         // U = Rᵀ F
         let u00 = co * f[0] + si * f[2];
@@ -198,7 +234,14 @@ impl Mechanics {
         let u10 = -si * f[0] + co * f[2];
         let u11 = -si * f[1] + co * f[3];
         let eps: Sym6 = [u00 - 1.0, u11 - 1.0, 0.0, 0.5 * (u01 + u10), 0.0, 0.0];
-        let de: Sym6 = [eps[0] - strain[0], eps[1] - strain[1], 0.0, eps[3] - strain[2], 0.0, 0.0];
+        let de: Sym6 = [
+            eps[0] - strain[0],
+            eps[1] - strain[1],
+            0.0,
+            eps[3] - strain[2],
+            0.0,
+            0.0,
+        ];
         strain.copy_from_slice(&[eps[0], eps[1], eps[3]]);
         let mut sig: Sym6 = [stress[0], stress[1], *szz, stress[2], 0.0, 0.0];
         let model = self.model_of(e);
@@ -209,14 +252,27 @@ impl Mechanics {
         if inp.damping && model.damp_factor() > 0.0 {
             let vv = |n: usize, k: usize| inp.v[n + k];
             let (vx0, vy0) = (vv(n0, 0), vv(n0, 1));
-            let dv = [vv(n1, 0) - vx0, vv(n2, 0) - vx0, vv(n1, 1) - vy0, vv(n2, 1) - vy0];
-            let fd = [dv[0] * m[0] + dv[1] * m[2], dv[0] * m[1] + dv[1] * m[3], dv[2] * m[0] + dv[3] * m[2], dv[2] * m[1] + dv[3] * m[3]];
+            let dv = [
+                vv(n1, 0) - vx0,
+                vv(n2, 0) - vx0,
+                vv(n1, 1) - vy0,
+                vv(n2, 1) - vy0,
+            ];
+            let fd = [
+                dv[0] * m[0] + dv[1] * m[2],
+                dv[0] * m[1] + dv[1] * m[3],
+                dv[2] * m[0] + dv[3] * m[2],
+                dv[2] * m[1] + dv[3] * m[3],
+            ];
             let r00 = co * fd[0] + si * fd[2];
             let r01 = co * fd[1] + si * fd[3];
             let r10 = -si * fd[0] + co * fd[2];
             let r11 = -si * fd[1] + co * fd[3];
             // eq. 17-19: σ_v = D_f C ε̇ with C = 2 L √(ρE)
-            let cv = model.damp_factor() * 2.0 * self.geo.mean_edge[e] * (model.density() * model.young()).sqrt();
+            let cv = model.damp_factor()
+                * 2.0
+                * self.geo.mean_edge[e]
+                * (model.density() * model.young()).sqrt();
             sxx += cv * r00;
             syy += cv * r11;
             sxy += cv * 0.5 * (r01 + r10);
@@ -229,16 +285,43 @@ impl Mechanics {
         let vol = self.geo.volume[e];
         let g1 = [m[0], m[1]];
         let g2 = [m[2], m[3]];
-        let f1 = [-vol * (p00 * g1[0] + p01 * g1[1]), -vol * (p10 * g1[0] + p11 * g1[1])];
-        let f2 = [-vol * (p00 * g2[0] + p01 * g2[1]), -vol * (p10 * g2[0] + p11 * g2[1])];
-        slots.copy_from_slice(&[-(f1[0] + f2[0]), -(f1[1] + f2[1]), f1[0], f1[1], f2[0], f2[1]]);
+        let f1 = [
+            -vol * (p00 * g1[0] + p01 * g1[1]),
+            -vol * (p10 * g1[0] + p11 * g1[1]),
+        ];
+        let f2 = [
+            -vol * (p00 * g2[0] + p01 * g2[1]),
+            -vol * (p10 * g2[0] + p11 * g2[1]),
+        ];
+        slots.copy_from_slice(&[
+            -(f1[0] + f2[0]),
+            -(f1[1] + f2[1]),
+            f1[0],
+            f1[1],
+            f2[0],
+            f2[1],
+        ]);
     }
 
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn element_3d(&self, e: usize, inp: &StepInputs<'_>, slots: &mut [f64], stress: &mut [f64], strain: &mut [f64], rot: &mut [f64], state: &mut [f64]) {
+    fn element_3d(
+        &self,
+        e: usize,
+        inp: &StepInputs<'_>,
+        slots: &mut [f64],
+        stress: &mut [f64],
+        strain: &mut [f64],
+        rot: &mut [f64],
+        state: &mut [f64],
+    ) {
         let c = &inp.conn[4 * e..4 * e + 4];
-        let n: [usize; 4] = [c[0] as usize * 3, c[1] as usize * 3, c[2] as usize * 3, c[3] as usize * 3];
+        let n: [usize; 4] = [
+            c[0] as usize * 3,
+            c[1] as usize * 3,
+            c[2] as usize * 3,
+            c[3] as usize * 3,
+        ];
         let p = |nn: usize, k: usize| inp.x0[nn + k] + inp.u[nn + k];
         let m: &[f64] = &self.geo.dm_inv[9 * e..9 * e + 9];
         let mut ds = [0.0; 9];
@@ -254,13 +337,22 @@ impl Mechanics {
         let r = polar_3d(&f, &r_prev);
         rot.copy_from_slice(&r);
         let u = crate::kinematics::mul3_tn(&r, &f);
-        let eps: Sym6 = [u[0] - 1.0, u[4] - 1.0, u[8] - 1.0, 0.5 * (u[1] + u[3]), 0.5 * (u[5] + u[7]), 0.5 * (u[2] + u[6])];
+        let eps: Sym6 = [
+            u[0] - 1.0,
+            u[4] - 1.0,
+            u[8] - 1.0,
+            0.5 * (u[1] + u[3]),
+            0.5 * (u[5] + u[7]),
+            0.5 * (u[2] + u[6]),
+        ];
         let mut de = [0.0; 6];
         for k in 0..6 {
             de[k] = eps[k] - strain[k];
         }
         strain.copy_from_slice(&eps);
-        let mut sig: Sym6 = [stress[0], stress[1], stress[2], stress[3], stress[4], stress[5]];
+        let mut sig: Sym6 = [
+            stress[0], stress[1], stress[2], stress[3], stress[4], stress[5],
+        ];
         let model = self.model_of(e);
         model.update(&eps, &de, &mut sig, state);
         stress.copy_from_slice(&sig);
@@ -274,7 +366,10 @@ impl Mechanics {
             }
             let fd = crate::kinematics::mul3(&dv, &mm);
             let rd = crate::kinematics::mul3_tn(&r, &fd);
-            let cv = model.damp_factor() * 2.0 * self.geo.mean_edge[e] * (model.density() * model.young()).sqrt();
+            let cv = model.damp_factor()
+                * 2.0
+                * self.geo.mean_edge[e]
+                * (model.density() * model.young()).sqrt();
             sig[0] += cv * rd[0];
             sig[1] += cv * rd[4];
             sig[2] += cv * rd[8];
@@ -282,13 +377,18 @@ impl Mechanics {
             sig[4] += cv * 0.5 * (rd[5] + rd[7]);
             sig[5] += cv * 0.5 * (rd[2] + rd[6]);
         }
-        let s = [sig[0], sig[3], sig[5], sig[3], sig[1], sig[4], sig[5], sig[4], sig[2]];
+        let s = [
+            sig[0], sig[3], sig[5], sig[3], sig[1], sig[4], sig[5], sig[4], sig[2],
+        ];
         let pk = crate::kinematics::mul3(&r, &s);
         let vol = self.geo.volume[e];
         let mut f0 = [0.0; 3];
         for a in 0..3 {
             for i in 0..3 {
-                let fa = -vol * (pk[3 * i] * mm[3 * a] + pk[3 * i + 1] * mm[3 * a + 1] + pk[3 * i + 2] * mm[3 * a + 2]);
+                let fa = -vol
+                    * (pk[3 * i] * mm[3 * a]
+                        + pk[3 * i + 1] * mm[3 * a + 1]
+                        + pk[3 * i + 2] * mm[3 * a + 2]);
                 slots[3 * (a + 1) + i] = fa;
                 f0[i] -= fa;
             }
@@ -303,8 +403,17 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
     }
 
     fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
-        let n_state = self.assignments.iter().map(|a| a.1.n_state()).max().unwrap_or(0);
-        let extra = if D::D == 2 { FieldSpec::new(names::STRESS_ZZ, Location::Element, 1) } else { FieldSpec::new(names::ROTATION, Location::Element, 9) };
+        let n_state = self
+            .assignments
+            .iter()
+            .map(|a| a.1.n_state())
+            .max()
+            .unwrap_or(0);
+        let extra = if D::D == 2 {
+            FieldSpec::new(names::STRESS_ZZ, Location::Element, 1)
+        } else {
+            FieldSpec::new(names::ROTATION, Location::Element, 9)
+        };
         vec![
             FieldSpec::new(names::STRESS, Location::Element, D::NSYM),
             FieldSpec::new(names::STRAIN, Location::Element, D::NSYM),
@@ -318,17 +427,32 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
         let mesh = ctx.mesh;
         let ne = mesh.n_elements();
         if self.assignments.is_empty() {
-            return Err(MechError::param("material", "none", "assign at least one constitutive model with Mechanics::material").into());
+            return Err(MechError::param(
+                "material",
+                "none",
+                "assign at least one constitutive model with Mechanics::material",
+            )
+            .into());
         }
         if self.assignments.len() > u16::MAX as usize {
-            return Err(MechError::param("material count", self.assignments.len(), "at most 65535 assignments").into());
+            return Err(MechError::param(
+                "material count",
+                self.assignments.len(),
+                "at most 65535 assignments",
+            )
+            .into());
         }
         let mut material = vec![u16::MAX; ne];
         self.models.clear();
         for (i, (range, model)) in self.assignments.iter().enumerate() {
             let sel = mesh.select_elements(range).map_err(MechError::from)?;
             if sel.is_empty() {
-                return Err(MechError::EmptyRange { what: format!("material {} ({})", i, model.name()), range: format!("{range:?}"), entity: "element" }.into());
+                return Err(MechError::EmptyRange {
+                    what: format!("material {} ({})", i, model.name()),
+                    range: format!("{range:?}"),
+                    entity: "element",
+                }
+                .into());
             }
             for e in sel {
                 material[e as usize] = i as u16;
@@ -336,16 +460,30 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
             self.models.push(model.clone());
         }
         if let Some(e) = material.iter().position(|&m| m == u16::MAX) {
-            return Err(MechError::param(format!("material of element {e}"), "none", "every element needs a constitutive model; add a Mechanics::material covering it").into());
+            return Err(MechError::param(
+                format!("material of element {e}"),
+                "none",
+                "every element needs a constitutive model; add a Mechanics::material covering it",
+            )
+            .into());
         }
         self.material = material;
         self.n_state = self.models.iter().map(|m| m.n_state()).max().unwrap_or(0);
         self.geo = geometry(mesh);
         let stress = ctx.fields.id(names::STRESS)?;
         let strain = ctx.fields.id(names::STRAIN)?;
-        let extra = ctx.fields.id(if D::D == 2 { names::STRESS_ZZ } else { names::ROTATION })?;
+        let extra = ctx.fields.id(if D::D == 2 {
+            names::STRESS_ZZ
+        } else {
+            names::ROTATION
+        })?;
         let state = ctx.fields.id(names::MODEL_STATE)?;
-        self.ids = Some(Ids { stress, strain, extra, state });
+        self.ids = Some(Ids {
+            stress,
+            strain,
+            extra,
+            state,
+        });
         if D::D == 3 {
             let rot = ctx.fields.get_mut(extra);
             for r in rot.chunks_exact_mut(9) {
@@ -355,7 +493,12 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
         for (range, s0) in &self.initial_stress {
             let sel = mesh.select_elements(range).map_err(MechError::from)?;
             if s0.iter().any(|v| !v.is_finite()) {
-                return Err(MechError::param("initial stress", format!("{s0:?}"), "must be finite").into());
+                return Err(MechError::param(
+                    "initial stress",
+                    format!("{s0:?}"),
+                    "must be finite",
+                )
+                .into());
             }
             let [st, zz] = ctx.fields.get_many_mut([stress, extra]);
             for e in sel {
@@ -378,7 +521,13 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
         Ok(())
     }
 
-    fn add_mass(&self, mesh: &Mesh<D>, _fields: &FieldStore, mass: &mut [f64], scale_to_dt: Option<f64>) {
+    fn add_mass(
+        &self,
+        mesh: &Mesh<D>,
+        _fields: &FieldStore,
+        mass: &mut [f64],
+        scale_to_dt: Option<f64>,
+    ) {
         let npe = D::NODES_PER_ELEM;
         for (e, conn) in mesh.elements().chunks_exact(npe).enumerate() {
             let mut m = self.model_of(e).density() * self.geo.volume[e] / npe as f64;
@@ -401,16 +550,31 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
                 which = e;
             }
         }
-        Some(StableStep { dt: best, entity: format!("element {which}"), physics: "mechanics".into() })
+        Some(StableStep {
+            dt: best,
+            entity: format!("element {which}"),
+            physics: "mechanics".into(),
+        })
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, CpuBackend>) -> Result<(), ComputeError> {
+    fn compute_forces(
+        &self,
+        ctx: &mut ForceContext<'_, D, CpuBackend>,
+    ) -> Result<(), ComputeError> {
         let ids = self.ids();
         let (d, npe, nsym) = (D::D, D::NODES_PER_ELEM, D::NSYM);
         let nx = if d == 2 { 1 } else { 9 };
         let ns = self.n_state.max(1);
-        let inp = StepInputs { conn: ctx.kin.mesh.elements(), x0: ctx.kin.mesh.coords(), u: ctx.kin.u, v: ctx.kin.v, damping: ctx.kin.damping };
-        let [stress, strain, extra, state] = ctx.fields.get_many_mut([ids.stress, ids.strain, ids.extra, ids.state]);
+        let inp = StepInputs {
+            conn: ctx.kin.mesh.elements(),
+            x0: ctx.kin.mesh.coords(),
+            u: ctx.kin.u,
+            v: ctx.kin.v,
+            damping: ctx.kin.damping,
+        };
+        let [stress, strain, extra, state] = ctx
+            .fields
+            .get_many_mut([ids.stress, ids.strain, ids.extra, ids.state]);
         let slots = &mut *ctx.slots;
         ctx.backend.install(|| {
             slots
@@ -440,11 +604,21 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
         Ok(())
     }
 
-    fn linear_stiffness(&self, mesh: &Mesh<D>, _fields: &FieldStore, trip: &mut Vec<(usize, usize, f64)>) -> Result<bool, ComputeError> {
+    fn linear_stiffness(
+        &self,
+        mesh: &Mesh<D>,
+        _fields: &FieldStore,
+        trip: &mut Vec<(usize, usize, f64)>,
+    ) -> Result<bool, ComputeError> {
         let (d, npe) = (D::D, D::NODES_PER_ELEM);
         for e in 0..mesh.n_elements() {
             let model = self.model_of(e);
-            let t = model.linear_tangent().ok_or_else(|| ComputeError::NotLinear(format!("model '{}' of element {e} is not linear", model.name())))?;
+            let t = model.linear_tangent().ok_or_else(|| {
+                ComputeError::NotLinear(format!(
+                    "model '{}' of element {e} is not linear",
+                    model.name()
+                ))
+            })?;
             // C_ijkl from the 6x6 tangent on tensor components.
             let voigt = |i: usize, j: usize| -> usize {
                 match (i.min(j), i.max(j)) {
@@ -480,7 +654,11 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
                                     kv += grad[a][j] * cijkl(i, j, k, l) * grad[b][l];
                                 }
                             }
-                            trip.push((conn[a] as usize * d + i, conn[b] as usize * d + k, vol * kv));
+                            trip.push((
+                                conn[a] as usize * d + i,
+                                conn[b] as usize * d + k,
+                                vol * kv,
+                            ));
                         }
                     }
                 }
@@ -491,18 +669,28 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
 
     fn stored_energy(&self, _kin: &Kinematics<'_, D>, fields: &FieldStore) -> f64 {
         let ids = self.ids();
-        let (st, ep, ex) = (fields.get(ids.stress), fields.get(ids.strain), fields.get(ids.extra));
+        let (st, ep, ex) = (
+            fields.get(ids.stress),
+            fields.get(ids.strain),
+            fields.get(ids.extra),
+        );
         let nsym = D::NSYM;
         (0..self.material.len())
             .map(|e| {
                 let (s, t) = if D::D == 2 {
                     let s = &st[3 * e..3 * e + 3];
                     let t = &ep[3 * e..3 * e + 3];
-                    ([s[0], s[1], ex[e], s[2], 0.0, 0.0], [t[0], t[1], 0.0, t[2], 0.0, 0.0])
+                    (
+                        [s[0], s[1], ex[e], s[2], 0.0, 0.0],
+                        [t[0], t[1], 0.0, t[2], 0.0, 0.0],
+                    )
                 } else {
                     let s = &st[nsym * e..nsym * e + 6];
                     let t = &ep[nsym * e..nsym * e + 6];
-                    ([s[0], s[1], s[2], s[3], s[4], s[5]], [t[0], t[1], t[2], t[3], t[4], t[5]])
+                    (
+                        [s[0], s[1], s[2], s[3], s[4], s[5]],
+                        [t[0], t[1], t[2], t[3], t[4], t[5]],
+                    )
                 };
                 0.5 * self.geo.volume[e] * double_dot(&s, &t)
             })

@@ -62,7 +62,12 @@ pub struct LinearElastic {
 impl LinearElastic {
     /// From Young's modulus E (Pa), Poisson's ratio ν and density ρ (kg/m³).
     pub fn new(young: f64, poisson: f64, density: f64) -> Result<Self, MechError> {
-        let m = LinearElastic { young, poisson, density, damp_factor: 0.0 };
+        let m = LinearElastic {
+            young,
+            poisson,
+            density,
+            damp_factor: 0.0,
+        };
         m.check()?;
         Ok(m)
     }
@@ -71,10 +76,18 @@ impl LinearElastic {
     /// keywords `bulk` and `shear`): E = 9KG/(3K+G), ν = (3K-2G)/(2(3K+G)).
     pub fn from_bulk_shear(bulk: f64, shear: f64, density: f64) -> Result<Self, MechError> {
         if !(bulk > 0.0 && bulk.is_finite()) {
-            return Err(MechError::param("bulk modulus K", bulk, "must be positive and finite"));
+            return Err(MechError::param(
+                "bulk modulus K",
+                bulk,
+                "must be positive and finite",
+            ));
         }
         if !(shear > 0.0 && shear.is_finite()) {
-            return Err(MechError::param("shear modulus G", shear, "must be positive and finite"));
+            return Err(MechError::param(
+                "shear modulus G",
+                shear,
+                "must be positive and finite",
+            ));
         }
         let young = 9.0 * bulk * shear / (3.0 * bulk + shear);
         let poisson = (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear));
@@ -90,16 +103,28 @@ impl LinearElastic {
 
     fn check(&self) -> Result<(), MechError> {
         if !(self.young > 0.0 && self.young.is_finite()) {
-            return Err(MechError::param("Young's modulus E", self.young, "must be positive and finite"));
+            return Err(MechError::param(
+                "Young's modulus E",
+                self.young,
+                "must be positive and finite",
+            ));
         }
         if !(0.0..0.5).contains(&self.poisson) {
             return Err(MechError::param("Poisson's ratio ν", self.poisson, "must lie in [0, 0.5) (0.5 is incompressible, which explicit elements cannot represent)"));
         }
         if !(self.density > 0.0 && self.density.is_finite()) {
-            return Err(MechError::param("density ρ", self.density, "must be positive and finite"));
+            return Err(MechError::param(
+                "density ρ",
+                self.density,
+                "must be positive and finite",
+            ));
         }
         if !(self.damp_factor >= 0.0 && self.damp_factor.is_finite()) {
-            return Err(MechError::param("damping factor D_f", self.damp_factor, "must be non-negative and finite"));
+            return Err(MechError::param(
+                "damping factor D_f",
+                self.damp_factor,
+                "must be non-negative and finite",
+            ));
         }
         Ok(())
     }
@@ -123,7 +148,14 @@ impl LinearElastic {
     pub fn stress_of(&self, e: &Sym6) -> Sym6 {
         let (l, m) = (self.lambda(), self.shear());
         let tr = e[0] + e[1] + e[2];
-        [l * tr + 2.0 * m * e[0], l * tr + 2.0 * m * e[1], l * tr + 2.0 * m * e[2], 2.0 * m * e[3], 2.0 * m * e[4], 2.0 * m * e[5]]
+        [
+            l * tr + 2.0 * m * e[0],
+            l * tr + 2.0 * m * e[1],
+            l * tr + 2.0 * m * e[2],
+            2.0 * m * e[3],
+            2.0 * m * e[4],
+            2.0 * m * e[5],
+        ]
     }
 }
 

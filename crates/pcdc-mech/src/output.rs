@@ -23,11 +23,21 @@ pub fn global_stress<D: Dim>(sim: &Simulation<D, CpuBackend>) -> Result<Vec<f64>
             mesh.element_coords(e, &mut xr);
             let c = mesh.element(e);
             let p = |a: usize, k: usize| x[c[a] as usize * 2 + k];
-            let ds = [p(1, 0) - p(0, 0), p(2, 0) - p(0, 0), p(1, 1) - p(0, 1), p(2, 1) - p(0, 1)];
+            let ds = [
+                p(1, 0) - p(0, 0),
+                p(2, 0) - p(0, 0),
+                p(1, 1) - p(0, 1),
+                p(2, 1) - p(0, 1),
+            ];
             let dm = [xr[2] - xr[0], xr[4] - xr[0], xr[3] - xr[1], xr[5] - xr[1]];
             let det = dm[0] * dm[3] - dm[1] * dm[2];
             let mi = [dm[3] / det, -dm[1] / det, -dm[2] / det, dm[0] / det];
-            let f = [ds[0] * mi[0] + ds[1] * mi[2], ds[0] * mi[1] + ds[1] * mi[3], ds[2] * mi[0] + ds[3] * mi[2], ds[2] * mi[1] + ds[3] * mi[3]];
+            let f = [
+                ds[0] * mi[0] + ds[1] * mi[2],
+                ds[0] * mi[1] + ds[1] * mi[3],
+                ds[2] * mi[0] + ds[3] * mi[2],
+                ds[2] * mi[1] + ds[3] * mi[3],
+            ];
             let (co, si) = polar_2d(&f);
             let (a, b, cxy) = (s[3 * e], s[3 * e + 1], s[3 * e + 2]);
             out[3 * e] = co * co * a - 2.0 * co * si * cxy + si * si * b;
@@ -40,7 +50,10 @@ pub fn global_stress<D: Dim>(sim: &Simulation<D, CpuBackend>) -> Result<Vec<f64>
             let r: [f64; 9] = rot[9 * e..9 * e + 9].try_into().expect("9 values");
             let v = &s[6 * e..6 * e + 6];
             let m = [v[0], v[3], v[5], v[3], v[1], v[4], v[5], v[4], v[2]];
-            let g = mul3(&r, &mul3_tn(&[r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]], &m));
+            let g = mul3(
+                &r,
+                &mul3_tn(&[r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]], &m),
+            );
             out[6 * e..6 * e + 6].copy_from_slice(&[g[0], g[4], g[8], g[1], g[5], g[2]]);
         }
     }
@@ -63,7 +76,8 @@ pub fn principal_stress<D: Dim>(global: &[f64]) -> Vec<f64> {
         global
             .chunks_exact(6)
             .flat_map(|s| {
-                let m = nalgebra::Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2]);
+                let m =
+                    nalgebra::Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2]);
                 let mut ev: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
                 ev.sort_by(|a, b| b.total_cmp(a));
                 ev
@@ -80,18 +94,76 @@ pub fn displacement<D: Dim>(sim: &Simulation<D, CpuBackend>) -> Result<Vec<f64>,
 
 /// Writes one VTU step with displacement, velocity, global stress, principal stresses and
 /// strain, on the deformed configuration.
-pub fn write_step<D: Dim>(series: &mut PvdSeries, sim: &Simulation<D, CpuBackend>) -> Result<std::path::PathBuf, MechError> {
+pub fn write_step<D: Dim>(
+    series: &mut PvdSeries,
+    sim: &Simulation<D, CpuBackend>,
+) -> Result<std::path::PathBuf, MechError> {
     let disp = displacement(sim)?;
     let stress = global_stress(sim)?;
     let principal = principal_stress::<D>(&stress);
     let strain = sim.field(names::STRAIN)?;
     let x = sim.positions();
     let np = if D::D == 2 { 2 } else { 3 };
-    let mut cells = vec![DataArray::SymTensor { name: "stress", values: &stress }, DataArray::SymTensor { name: "strain", values: strain }];
+    let mut cells = vec![
+        DataArray::SymTensor {
+            name: "stress",
+            values: &stress,
+        },
+        DataArray::SymTensor {
+            name: "strain",
+            values: strain,
+        },
+    ];
     let p1: Vec<f64> = principal.iter().step_by(np).copied().collect();
     let pn: Vec<f64> = principal.iter().skip(np - 1).step_by(np).copied().collect();
-    cells.push(DataArray::Scalar { name: "sigma_1", values: &p1 });
-    cells.push(DataArray::Scalar { name: "sigma_min", values: &pn });
-    let path = series.write_step(sim.state.time, sim.mesh(), Some(&x), &[DataArray::Vector { name: "displacement", values: &disp }, DataArray::Vector { name: "velocity", values: &sim.state.v }], &cells)?;
+    cells.push(DataArray::Scalar {
+        name: "sigma_1",
+        values: &p1,
+    });
+    cells.push(DataArray::Scalar {
+        name: "sigma_min",
+        values: &pn,
+    });
+    let path = series.write_step(
+        sim.state.time,
+        sim.mesh(),
+        Some(&x),
+        &[
+            DataArray::Vector {
+                name: "displacement",
+                values: &disp,
+            },
+            DataArray::Vector {
+                name: "velocity",
+                values: &sim.state.v,
+            },
+        ],
+        &cells,
+    )?;
     Ok(path)
+}
+
+/// Area/volume-weighted average of per-element values at the nodes (`ncomp` values per
+/// element): the usual smoothing of constant-strain element stresses for plots and
+/// comparisons at nodes.
+pub fn nodal_average<D: Dim>(mesh: &pcdc_mesh::Mesh<D>, values: &[f64], ncomp: usize) -> Vec<f64> {
+    let n = mesh.n_nodes();
+    let mut sum = vec![0.0; n * ncomp];
+    let mut w = vec![0.0; n];
+    for e in 0..mesh.n_elements() {
+        let v = mesh.element_measure(e);
+        for &node in mesh.element(e) {
+            let node = node as usize;
+            w[node] += v;
+            for k in 0..ncomp {
+                sum[node * ncomp + k] += v * values[e * ncomp + k];
+            }
+        }
+    }
+    for node in 0..n {
+        for k in 0..ncomp {
+            sum[node * ncomp + k] /= w[node];
+        }
+    }
+    sum
 }

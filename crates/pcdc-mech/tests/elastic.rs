@@ -2,7 +2,9 @@
 //! save/restore, watchdog and static solves against closed forms.
 
 use pcdc_compute::{ComputeError, CpuBackend, Simulation, StaticOptions, Table};
-use pcdc_mech::{output, set_velocity, Boundary, Constraint, FaceStress, LinearElastic, MechError, Mechanics};
+use pcdc_mech::{
+    output, set_velocity, Boundary, Constraint, FaceStress, LinearElastic, MechError, Mechanics,
+};
 use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh, Range};
 use proptest::prelude::*;
 
@@ -17,7 +19,10 @@ fn cpu(t: usize) -> CpuBackend {
 }
 
 fn free_sim<D: Dim>(mesh: Mesh<D>) -> Simulation<D> {
-    Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::All, rock())).build().unwrap()
+    Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .build()
+        .unwrap()
 }
 
 fn max_abs(v: &[f64]) -> f64 {
@@ -49,7 +54,11 @@ fn rigid_rotation_is_stress_free_2d_and_3d() {
         let (c, s) = (t.cos(), t.sin());
         for (i, p) in x0.chunks_exact(3).enumerate() {
             // Rodrigues' rotation about `axis`.
-            let kx = [axis[1] * p[2] - axis[2] * p[1], axis[2] * p[0] - axis[0] * p[2], axis[0] * p[1] - axis[1] * p[0]];
+            let kx = [
+                axis[1] * p[2] - axis[2] * p[1],
+                axis[2] * p[0] - axis[0] * p[2],
+                axis[0] * p[1] - axis[1] * p[0],
+            ];
             let kd = axis[0] * p[0] + axis[1] * p[1] + axis[2] * p[2];
             for j in 0..3 {
                 s3.state.u[3 * i + j] = p[j] * c + kx[j] * s + axis[j] * kd * (1.0 - c) - p[j];
@@ -66,7 +75,12 @@ fn rigid_rotation_is_stress_free_2d_and_3d() {
 #[test]
 fn free_spin_through_a_full_turn() {
     let mesh = builders::disc([0.0, 0.0], 1.0, 0.4).unwrap();
-    let mut sim = Simulation::builder(mesh, cpu(2)).physics(Mechanics::new().material(Range::All, LinearElastic::new(E, 0.25, 1000.0).unwrap())).build().unwrap();
+    let mut sim = Simulation::builder(mesh, cpu(2))
+        .physics(
+            Mechanics::new().material(Range::All, LinearElastic::new(E, 0.25, 1000.0).unwrap()),
+        )
+        .build()
+        .unwrap();
     // ωR/c = 2e-4: real centrifugal stress ~ (ωR/c)² E = 4e-8 E, far below the bound.
     let omega = 2e-4 * (E / 1000.0f64).sqrt();
     let x0 = sim.mesh().coords().to_vec();
@@ -78,7 +92,10 @@ fn free_spin_through_a_full_turn() {
     sim.run_until(turn).unwrap();
     let st = max_abs(&output::global_stress(&sim).unwrap());
     let centrifugal = 1000.0 * omega * omega * 1.0;
-    assert!(st < 1e-6 * E, "stress after one turn {st:e} (centrifugal scale {centrifugal:e})");
+    assert!(
+        st < 1e-6 * E,
+        "stress after one turn {st:e} (centrifugal scale {centrifugal:e})"
+    );
 }
 
 proptest! {
@@ -150,9 +167,13 @@ fn distorted_rectangle(seed: u64) -> Mesh<Dim2> {
     let base = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.2).unwrap();
     let boundary = base.nodes_of_faces(&base.faces().boundary);
     let mut coords = base.coords().to_vec();
-    let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     let mut rnd = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
     };
     for n in 0..base.n_nodes() {
@@ -166,21 +187,36 @@ fn distorted_rectangle(seed: u64) -> Mesh<Dim2> {
 
 #[test]
 fn invalid_parameters_are_errors() {
-    assert!(matches!(LinearElastic::new(1e9, 0.5, 1000.0), Err(MechError::InvalidParameter { .. })));
+    assert!(matches!(
+        LinearElastic::new(1e9, 0.5, 1000.0),
+        Err(MechError::InvalidParameter { .. })
+    ));
     let e = LinearElastic::new(-1e9, 0.25, 1000.0).unwrap_err();
     assert!(e.to_string().contains("Young"), "{e}");
     assert!(LinearElastic::new(1e9, 0.25, 0.0).is_err());
-    assert!(LinearElastic::new(1e9, 0.25, 1.0).unwrap().with_damping(-1.0).is_err());
+    assert!(LinearElastic::new(1e9, 0.25, 1.0)
+        .unwrap()
+        .with_damping(-1.0)
+        .is_err());
     assert!(LinearElastic::from_bulk_shear(1e9, -1.0, 1000.0).is_err());
     // K/G giving ν < 0 is refused too.
     assert!(LinearElastic::from_bulk_shear(1e9, 2e9, 1000.0).is_err());
     // A mesh without a material for every element is an error naming the element.
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
-    let err = Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::rect(0.0, 0.0, 0.5, 1.0), rock())).build().err().unwrap();
+    let err = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::rect(0.0, 0.0, 0.5, 1.0), rock()))
+        .build()
+        .err()
+        .unwrap();
     assert!(err.to_string().contains("element"), "{err}");
     // A boundary range that selects nothing is an error.
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
-    let err = Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::All, rock())).physics(Boundary::new().fix(Range::rect(5.0, 5.0, 6.0, 6.0))).build().err().unwrap();
+    let err = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(Boundary::new().fix(Range::rect(5.0, 5.0, 6.0, 6.0)))
+        .build()
+        .err()
+        .unwrap();
     assert!(err.to_string().contains("selects no node"), "{err}");
 }
 
@@ -219,7 +255,11 @@ fn loaded_block(threads: usize) -> Simulation<Dim2> {
     let vel = Table::new("top velocity", &[(0.0, 0.0), (1e-3, -0.05)]).unwrap();
     Simulation::builder(mesh, cpu(threads))
         .physics(Mechanics::new().material(Range::All, rock().with_damping(0.1).unwrap()))
-        .physics(Boundary::new().fix(Range::group("bottom")).velocity(Range::group("top"), [None, Some(vel.into()), None]))
+        .physics(
+            Boundary::new()
+                .fix(Range::group("bottom"))
+                .velocity(Range::group("top"), [None, Some(vel.into()), None]),
+        )
         .gravity([0.0, -9.81, 0.0])
         .build()
         .unwrap()
@@ -231,8 +271,18 @@ fn identical_results_for_any_thread_count() {
     let mut b = loaded_block(2);
     a.run(300).unwrap();
     b.run(300).unwrap();
-    assert!(a.state.u.iter().zip(&b.state.u).all(|(x, y)| x.to_bits() == y.to_bits()));
-    assert!(a.field("stress").unwrap().iter().zip(b.field("stress").unwrap()).all(|(x, y)| x.to_bits() == y.to_bits()));
+    assert!(a
+        .state
+        .u
+        .iter()
+        .zip(&b.state.u)
+        .all(|(x, y)| x.to_bits() == y.to_bits()));
+    assert!(a
+        .field("stress")
+        .unwrap()
+        .iter()
+        .zip(b.field("stress").unwrap())
+        .all(|(x, y)| x.to_bits() == y.to_bits()));
 }
 
 #[test]
@@ -249,25 +299,47 @@ fn save_restore_continues_bit_for_bit() {
     assert_eq!(b.state.step, 150);
     b.run(150).unwrap();
     assert_eq!(a.state.time.to_bits(), b.state.time.to_bits());
-    assert!(a.state.u.iter().zip(&b.state.u).all(|(x, y)| x.to_bits() == y.to_bits()));
-    assert!(a.state.v.iter().zip(&b.state.v).all(|(x, y)| x.to_bits() == y.to_bits()));
+    assert!(a
+        .state
+        .u
+        .iter()
+        .zip(&b.state.u)
+        .all(|(x, y)| x.to_bits() == y.to_bits()));
+    assert!(a
+        .state
+        .v
+        .iter()
+        .zip(&b.state.v)
+        .all(|(x, y)| x.to_bits() == y.to_bits()));
     // A snapshot of another scene is refused.
     let mut other = free_sim(builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap());
-    assert!(matches!(other.restore(&path), Err(ComputeError::SnapshotMismatch(_))));
+    assert!(matches!(
+        other.restore(&path),
+        Err(ComputeError::SnapshotMismatch(_))
+    ));
     std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn watchdog_names_step_and_node() {
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.1).unwrap();
-    let mut sim = Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::All, rock())).physics(Boundary::new().fix(Range::group("bottom"))).gravity([0.0, -9.81, 0.0]).time_step(1e-3).build().unwrap();
+    let mut sim = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(Boundary::new().fix(Range::group("bottom")))
+        .gravity([0.0, -9.81, 0.0])
+        .time_step(1e-3)
+        .build()
+        .unwrap();
     let limit = sim.time_step_limit().unwrap().clone();
     assert!(limit.entity.starts_with("element "), "{limit:?}");
     assert!(limit.dt < 1e-3);
     let err = sim.run(100_000).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, ComputeError::Diverged { .. }), "{msg}");
-    assert!(msg.contains("step") && msg.contains("node") && msg.contains("Hint"), "{msg}");
+    assert!(
+        msg.contains("step") && msg.contains("node") && msg.contains("Hint"),
+        "{msg}"
+    );
 }
 
 /// Uniaxial strain column under a top stress, sides on rollers: σ_yy = p everywhere and
@@ -285,7 +357,13 @@ fn static_solvers_match_uniaxial_strain() {
                     .constraint(Range::group("bottom"), Constraint::Line([1.0, 0.0, 0.0]))
                     .constraint(Range::group("left"), Constraint::Line([0.0, 1.0, 0.0]))
                     .constraint(Range::group("right"), Constraint::Line([0.0, 1.0, 0.0]))
-                    .face_stress(Range::group("top"), FaceStress { yy: Some(p.into()), ..Default::default() }),
+                    .face_stress(
+                        Range::group("top"),
+                        FaceStress {
+                            yy: Some(p.into()),
+                            ..Default::default()
+                        },
+                    ),
             )
             .build()
             .unwrap()
@@ -293,18 +371,35 @@ fn static_solvers_match_uniaxial_strain() {
     let m = rock().lambda() + 2.0 * rock().shear();
     let expect = p * h / m;
     let mut direct = build();
-    let rep = direct.solve_linear(&StaticOptions { tolerance: 1e-9, ..Default::default() }).unwrap();
+    let rep = direct
+        .solve_linear(&StaticOptions {
+            tolerance: 1e-9,
+            ..Default::default()
+        })
+        .unwrap();
     let mut relaxed = build();
-    let rep2 = relaxed.relax(&StaticOptions { tolerance: 1e-7, ..Default::default() }).unwrap();
+    let rep2 = relaxed
+        .relax(&StaticOptions {
+            tolerance: 1e-7,
+            ..Default::default()
+        })
+        .unwrap();
     for (name, sim) in [("direct", &direct), ("relaxation", &relaxed)] {
         let top = sim.mesh().select_nodes(&Range::group("top")).unwrap();
         for &n in &top {
             let uy = sim.state.u[2 * n as usize + 1];
-            assert!((uy - expect).abs() < 1e-4 * expect.abs(), "{name}: u_y {uy} vs {expect}");
+            assert!(
+                (uy - expect).abs() < 1e-4 * expect.abs(),
+                "{name}: u_y {uy} vs {expect}"
+            );
         }
         let s = output::global_stress(sim).unwrap();
         for e in s.chunks_exact(3) {
-            assert!((e[1] - p).abs() < 1e-4 * p.abs(), "{name}: σyy {} vs {p}", e[1]);
+            assert!(
+                (e[1] - p).abs() < 1e-4 * p.abs(),
+                "{name}: σyy {} vs {p}",
+                e[1]
+            );
         }
     }
     assert!(rep.steps <= 3, "{rep:?}");
@@ -320,15 +415,32 @@ fn normal_face_stress_gives_hydrostatic_disc() {
         .physics(
             Boundary::new()
                 .face_stress(Range::group("boundary"), FaceStress::normal(-1.0e6))
-                .constraint(Range::Ball { center: [0.0; 3], radius: 1e-9 }, Constraint::Fixed)
-                .constraint(Range::plane([0.0; 3], [0.0, 1.0, 0.0], 1e-9).and(Range::Ball { center: [1.0, 0.0, 0.0], radius: 1e-6 }), Constraint::Line([1.0, 0.0, 0.0])),
+                .constraint(
+                    Range::Ball {
+                        center: [0.0; 3],
+                        radius: 1e-9,
+                    },
+                    Constraint::Fixed,
+                )
+                .constraint(
+                    Range::plane([0.0; 3], [0.0, 1.0, 0.0], 1e-9).and(Range::Ball {
+                        center: [1.0, 0.0, 0.0],
+                        radius: 1e-6,
+                    }),
+                    Constraint::Line([1.0, 0.0, 0.0]),
+                ),
         )
         .build()
         .unwrap();
     sim.solve_linear(&StaticOptions::default()).unwrap();
     let s = output::global_stress(&sim).unwrap();
     for e in s.chunks_exact(3) {
-        assert!((e[0] + 1.0e6).abs() < 1e-3 * 1e6 && (e[1] + 1.0e6).abs() < 1e-3 * 1e6 && e[2].abs() < 1e-3 * 1e6, "{e:?}");
+        assert!(
+            (e[0] + 1.0e6).abs() < 1e-3 * 1e6
+                && (e[1] + 1.0e6).abs() < 1e-3 * 1e6
+                && e[2].abs() < 1e-3 * 1e6,
+            "{e:?}"
+        );
     }
 }
 
@@ -346,15 +458,28 @@ fn node_force_acceleration_and_line_constraint() {
     let n = sim.mesh().n_nodes() as f64;
     let dt = sim.dt();
     sim.run(100).unwrap();
-    let momentum: f64 = sim.state.v.chunks_exact(2).zip(sim.mass()).map(|(v, m)| m * v[0]).sum();
+    let momentum: f64 = sim
+        .state
+        .v
+        .chunks_exact(2)
+        .zip(sim.mass())
+        .map(|(v, m)| m * v[0])
+        .sum();
     let expect = 10.0 * n * 100.0 * dt;
     assert!((sim.mass().iter().sum::<f64>() - total_mass).abs() < 1e-9 * total_mass);
-    assert!((momentum - expect).abs() < 1e-9 * expect, "{momentum} vs {expect}");
+    assert!(
+        (momentum - expect).abs() < 1e-9 * expect,
+        "{momentum} vs {expect}"
+    );
 
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
     let mut sim = Simulation::builder(mesh, cpu(1))
         .physics(Mechanics::new().material(Range::All, rock()))
-        .physics(Boundary::new().acceleration(Range::group("bottom"), [Some(2.0.into()), None, None]).constraint(Range::group("top"), Constraint::Line([1.0, 1.0, 0.0])))
+        .physics(
+            Boundary::new()
+                .acceleration(Range::group("bottom"), [Some(2.0.into()), None, None])
+                .constraint(Range::group("top"), Constraint::Line([1.0, 1.0, 0.0])),
+        )
         .build()
         .unwrap();
     set_velocity(&mut sim, &Range::group("top"), [0.3, -0.1, 0.0]).unwrap();
@@ -375,7 +500,10 @@ fn node_force_acceleration_and_line_constraint() {
 fn damping_reduces_the_stable_step_and_dissipates() {
     let mk = |df: f64| {
         let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.2, 0.05).unwrap();
-        let mut sim = Simulation::builder(mesh, cpu(1)).physics(Mechanics::new().material(Range::All, rock().with_damping(df).unwrap())).build().unwrap();
+        let mut sim = Simulation::builder(mesh, cpu(1))
+            .physics(Mechanics::new().material(Range::All, rock().with_damping(df).unwrap()))
+            .build()
+            .unwrap();
         let x0 = sim.mesh().coords().to_vec();
         for (i, p) in x0.chunks_exact(2).enumerate() {
             sim.state.u[2 * i] = 1e-4 * p[0];
@@ -414,7 +542,11 @@ fn initial_stress_is_kept_in_equilibrium() {
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
     let s0 = [-1e6, -2e6, -0.75e6, 0.0, 0.0, 0.0];
     let mut sim = Simulation::builder(mesh, cpu(1))
-        .physics(Mechanics::new().material(Range::All, rock()).initial_stress(Range::All, s0))
+        .physics(
+            Mechanics::new()
+                .material(Range::All, rock())
+                .initial_stress(Range::All, s0),
+        )
         .physics(Boundary::new().face_stress(Range::All, FaceStress::diagonal(s0[0], s0[1], 0.0)))
         .build()
         .unwrap();

@@ -25,9 +25,7 @@ impl ElementKind {
 }
 
 /// A spatial dimension with its simplex element.
-pub trait Dim:
-    Copy + Clone + Debug + Default + PartialEq + Send + Sync + 'static
-{
+pub trait Dim: Copy + Clone + Debug + Default + PartialEq + Send + Sync + 'static {
     /// Number of space dimensions (2 or 3).
     const D: usize;
     /// Nodes per element (3 for Tri3, 4 for Tet4).
@@ -167,7 +165,12 @@ mod tests {
         let c = [1.0 / 3.0, 1.0 / 3.0];
         for f in 0..3 {
             let ln = Dim2::face_local_nodes(f);
-            let fx = [x[2 * ln[0]], x[2 * ln[0] + 1], x[2 * ln[1]], x[2 * ln[1] + 1]];
+            let fx = [
+                x[2 * ln[0]],
+                x[2 * ln[0] + 1],
+                x[2 * ln[1]],
+                x[2 * ln[1] + 1],
+            ];
             let mut n = [0.0; 2];
             Dim2::face_measure_normal(&fx, &mut n);
             assert!((fx[0] - c[0]) * n[0] + (fx[1] - c[1]) * n[1] > 0.0);

@@ -15,16 +15,29 @@ pub enum MeshError {
     NonFiniteCoordinate { node: usize },
     /// An element refers to a node that does not exist.
     #[error("element {element} refers to node {node}, but the mesh has {n_nodes} nodes")]
-    BadNodeIndex { element: usize, node: u32, n_nodes: usize },
+    BadNodeIndex {
+        element: usize,
+        node: u32,
+        n_nodes: usize,
+    },
     /// An element repeats a node.
     #[error("element {element} repeats node {node}")]
     RepeatedNode { element: usize, node: u32 },
     /// An element has negative measure (clockwise triangle, negative tetrahedron).
     #[error("element {element} is inverted (signed {measure_name} {measure:e}); its nodes must be counter-clockwise (Tri3) or positively oriented (Tet4)")]
-    InvertedElement { element: usize, measure: f64, measure_name: &'static str },
+    InvertedElement {
+        element: usize,
+        measure: f64,
+        measure_name: &'static str,
+    },
     /// An element has (near) zero measure.
     #[error("element {element} is degenerate ({measure_name} {measure:e}, below {threshold:e})")]
-    DegenerateElement { element: usize, measure: f64, threshold: f64, measure_name: &'static str },
+    DegenerateElement {
+        element: usize,
+        measure: f64,
+        threshold: f64,
+        measure_name: &'static str,
+    },
     /// A node is referenced by no element.
     #[error("node {node} is dangling: no element uses it")]
     DanglingNode { node: usize },
@@ -39,17 +52,34 @@ pub enum MeshError {
     UnknownGroup { kind: &'static str, name: String },
     /// A group refers to an entity that does not exist.
     #[error("{kind} group '{name}' refers to index {index}, but there are only {count}")]
-    BadGroupIndex { kind: &'static str, name: String, index: u32, count: usize },
+    BadGroupIndex {
+        kind: &'static str,
+        name: String,
+        index: u32,
+        count: usize,
+    },
     /// A geometric or builder parameter is invalid.
     #[error("invalid parameter {name} = {value}: {reason}")]
-    InvalidParameter { name: &'static str, value: f64, reason: &'static str },
+    InvalidParameter {
+        name: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
     /// A range is ill-formed (e.g. zero plane normal).
     #[error("invalid range: {0}")]
     InvalidRange(String),
     /// A Gmsh file could not be parsed.
     #[error("{file}:{line}: {message}")]
-    Parse { file: String, line: usize, message: String },
+    Parse {
+        file: String,
+        line: usize,
+        message: String,
+    },
     /// An input/output error, with the path involved.
     #[error("{path}: {source}")]
-    Io { path: String, #[source] source: std::io::Error },
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
 }

@@ -89,10 +89,16 @@ impl<D: Dim> Mesh<D> {
     fn build(coords: Vec<f64>, mut elements: Vec<u32>, reorient: bool) -> Result<Self, MeshError> {
         let (d, npe) = (D::D, D::NODES_PER_ELEM);
         if coords.len() % d != 0 {
-            return Err(MeshError::CoordLength { len: coords.len(), dim: d });
+            return Err(MeshError::CoordLength {
+                len: coords.len(),
+                dim: d,
+            });
         }
         if elements.len() % npe != 0 {
-            return Err(MeshError::ConnectivityLength { len: elements.len(), per_elem: npe });
+            return Err(MeshError::ConnectivityLength {
+                len: elements.len(),
+                per_elem: npe,
+            });
         }
         if elements.is_empty() {
             return Err(MeshError::Empty);
@@ -107,14 +113,22 @@ impl<D: Dim> Mesh<D> {
         for (e, conn) in elements.chunks_exact_mut(npe).enumerate() {
             for (a, &n) in conn.iter().enumerate() {
                 if n as usize >= n_nodes {
-                    return Err(MeshError::BadNodeIndex { element: e, node: n, n_nodes });
+                    return Err(MeshError::BadNodeIndex {
+                        element: e,
+                        node: n,
+                        n_nodes,
+                    });
                 }
                 if conn[..a].contains(&n) {
-                    return Err(MeshError::RepeatedNode { element: e, node: n });
+                    return Err(MeshError::RepeatedNode {
+                        element: e,
+                        node: n,
+                    });
                 }
             }
             for (a, &n) in conn.iter().enumerate() {
-                x[a * d..(a + 1) * d].copy_from_slice(&coords[n as usize * d..(n as usize + 1) * d]);
+                x[a * d..(a + 1) * d]
+                    .copy_from_slice(&coords[n as usize * d..(n as usize + 1) * d]);
                 used[n as usize] = true;
             }
             let mut measure = D::signed_measure(&x);
@@ -127,11 +141,20 @@ impl<D: Dim> Mesh<D> {
             }
             let threshold = DEGENERATE_REL * longest.powi(d as i32);
             if measure.is_nan() || measure.abs() <= threshold {
-                return Err(MeshError::DegenerateElement { element: e, measure, threshold, measure_name });
+                return Err(MeshError::DegenerateElement {
+                    element: e,
+                    measure,
+                    threshold,
+                    measure_name,
+                });
             }
             if measure < 0.0 {
                 if !reorient {
-                    return Err(MeshError::InvertedElement { element: e, measure, measure_name });
+                    return Err(MeshError::InvertedElement {
+                        element: e,
+                        measure,
+                        measure_name,
+                    });
                 }
                 conn.swap(0, 1);
                 measure = -measure;
@@ -141,7 +164,13 @@ impl<D: Dim> Mesh<D> {
             return Err(MeshError::DanglingNode { node });
         }
         let faces = build_faces::<D>(&elements)?;
-        Ok(Mesh { coords, elements, faces, groups: Groups::default(), _dim: PhantomData })
+        Ok(Mesh {
+            coords,
+            elements,
+            faces,
+            groups: Groups::default(),
+            _dim: PhantomData,
+        })
     }
 
     /// Number of nodes.
@@ -257,7 +286,11 @@ impl<D: Dim> Mesh<D> {
     }
 
     /// Adds (or replaces) a node group; indices are sorted and de-duplicated.
-    pub fn add_node_group(&mut self, name: impl Into<String>, mut nodes: Vec<u32>) -> Result<(), MeshError> {
+    pub fn add_node_group(
+        &mut self,
+        name: impl Into<String>,
+        mut nodes: Vec<u32>,
+    ) -> Result<(), MeshError> {
         let name = name.into();
         check_indices("node", &name, &nodes, self.n_nodes())?;
         nodes.sort_unstable();
@@ -267,7 +300,11 @@ impl<D: Dim> Mesh<D> {
     }
 
     /// Adds (or replaces) an element group.
-    pub fn add_element_group(&mut self, name: impl Into<String>, mut elems: Vec<u32>) -> Result<(), MeshError> {
+    pub fn add_element_group(
+        &mut self,
+        name: impl Into<String>,
+        mut elems: Vec<u32>,
+    ) -> Result<(), MeshError> {
         let name = name.into();
         check_indices("element", &name, &elems, self.n_elements())?;
         elems.sort_unstable();
@@ -277,7 +314,11 @@ impl<D: Dim> Mesh<D> {
     }
 
     /// Adds (or replaces) a face group.
-    pub fn add_face_group(&mut self, name: impl Into<String>, mut faces: Vec<u32>) -> Result<(), MeshError> {
+    pub fn add_face_group(
+        &mut self,
+        name: impl Into<String>,
+        mut faces: Vec<u32>,
+    ) -> Result<(), MeshError> {
         let name = name.into();
         check_indices("face", &name, &faces, self.faces.len())?;
         faces.sort_unstable();
@@ -297,13 +338,21 @@ impl<D: Dim> Mesh<D> {
         self.add_face_group(name, faces)
     }
 
-    fn check_range(&self, kind: &'static str, map: &BTreeMap<String, Vec<u32>>, range: &Range) -> Result<(), MeshError> {
+    fn check_range(
+        &self,
+        kind: &'static str,
+        map: &BTreeMap<String, Vec<u32>>,
+        range: &Range,
+    ) -> Result<(), MeshError> {
         range.validate()?;
         let mut names = Vec::new();
         range.group_names(&mut names);
         for n in names {
             if !map.contains_key(n) {
-                return Err(MeshError::UnknownGroup { kind, name: n.to_string() });
+                return Err(MeshError::UnknownGroup {
+                    kind,
+                    name: n.to_string(),
+                });
             }
         }
         Ok(())
@@ -358,7 +407,10 @@ impl<D: Dim> Mesh<D> {
 
     /// Nodes of the given faces, ascending and unique.
     pub fn nodes_of_faces(&self, faces: &[u32]) -> Vec<u32> {
-        let mut v: Vec<u32> = faces.iter().flat_map(|&f| self.face(f as usize).iter().copied()).collect();
+        let mut v: Vec<u32> = faces
+            .iter()
+            .flat_map(|&f| self.face(f as usize).iter().copied())
+            .collect();
         v.sort_unstable();
         v.dedup();
         v
@@ -369,9 +421,19 @@ fn member(map: &BTreeMap<String, Vec<u32>>, name: &str, i: u32) -> bool {
     map.get(name).is_some_and(|v| v.binary_search(&i).is_ok())
 }
 
-fn check_indices(kind: &'static str, name: &str, idx: &[u32], count: usize) -> Result<(), MeshError> {
+fn check_indices(
+    kind: &'static str,
+    name: &str,
+    idx: &[u32],
+    count: usize,
+) -> Result<(), MeshError> {
     match idx.iter().find(|&&i| i as usize >= count) {
-        Some(&index) => Err(MeshError::BadGroupIndex { kind, name: name.to_string(), index, count }),
+        Some(&index) => Err(MeshError::BadGroupIndex {
+            kind,
+            name: name.to_string(),
+            index,
+            count,
+        }),
         None => Ok(()),
     }
 }
@@ -405,7 +467,10 @@ fn build_faces<D: Dim>(elements: &[u32]) -> Result<Faces, MeshError> {
                 Some(&fi) => {
                     let fi = fi as usize;
                     if faces.neighbor[fi] != NO_NEIGHBOR {
-                        return Err(MeshError::NonManifoldFace { nodes: key[..npf].to_vec(), element: e });
+                        return Err(MeshError::NonManifoldFace {
+                            nodes: key[..npf].to_vec(),
+                            element: e,
+                        });
                     }
                     faces.neighbor[fi] = e as u32;
                 }
@@ -432,7 +497,11 @@ mod tests {
 
     fn square() -> Mesh<Dim2> {
         // Unit square cut on the diagonal.
-        Mesh::new(vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0], vec![0, 1, 2, 0, 2, 3]).unwrap()
+        Mesh::new(
+            vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0],
+            vec![0, 1, 2, 0, 2, 3],
+        )
+        .unwrap()
     }
 
     #[test]
@@ -446,11 +515,21 @@ mod tests {
 
     #[test]
     fn inverted_triangle_is_an_error_naming_the_element() {
-        let err = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0], vec![0, 1, 2, 0, 3, 2])
-            .unwrap_err();
-        assert!(matches!(err, MeshError::InvertedElement { element: 1, .. }), "{err}");
+        let err = Mesh::<Dim2>::new(
+            vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0],
+            vec![0, 1, 2, 0, 3, 2],
+        )
+        .unwrap_err();
+        assert!(
+            matches!(err, MeshError::InvertedElement { element: 1, .. }),
+            "{err}"
+        );
         assert!(err.to_string().contains("element 1"));
-        let fixed = Mesh::<Dim2>::new_reoriented(vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0], vec![0, 1, 2, 0, 3, 2]).unwrap();
+        let fixed = Mesh::<Dim2>::new_reoriented(
+            vec![0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0],
+            vec![0, 1, 2, 0, 3, 2],
+        )
+        .unwrap();
         assert!(fixed.element_measure(1) > 0.0);
     }
 
@@ -459,10 +538,19 @@ mod tests {
         let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, 0.0, 2.0, 0.0], vec![0, 1, 2]).unwrap_err();
         assert!(matches!(e, MeshError::DegenerateElement { element: 0, .. }));
         let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0], vec![0, 1, 7]).unwrap_err();
-        assert!(matches!(e, MeshError::BadNodeIndex { element: 0, node: 7, .. }));
-        let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 5.0, 5.0], vec![0, 1, 2]).unwrap_err();
+        assert!(matches!(
+            e,
+            MeshError::BadNodeIndex {
+                element: 0,
+                node: 7,
+                ..
+            }
+        ));
+        let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 5.0, 5.0], vec![0, 1, 2])
+            .unwrap_err();
         assert!(matches!(e, MeshError::DanglingNode { node: 3 }));
-        let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, f64::NAN, 0.0, 1.0], vec![0, 1, 2]).unwrap_err();
+        let e =
+            Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0, f64::NAN, 0.0, 1.0], vec![0, 1, 2]).unwrap_err();
         assert!(matches!(e, MeshError::NonFiniteCoordinate { node: 1 }));
         let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0], vec![0, 1, 2]).unwrap_err();
         assert!(matches!(e, MeshError::CoordLength { .. }));
@@ -470,7 +558,9 @@ mod tests {
 
     #[test]
     fn tet_mesh_faces() {
-        let coords = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        let coords = vec![
+            0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0,
+        ];
         let m = Mesh::<Dim3>::new_reoriented(coords, vec![0, 1, 2, 3, 1, 2, 3, 4]).unwrap();
         assert_eq!(m.faces().len(), 7);
         assert_eq!(m.faces().boundary.len(), 6);
@@ -480,17 +570,31 @@ mod tests {
     #[test]
     fn ranges_select() {
         let mut m = square();
-        let left = m.select_nodes(&Range::plane([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], 1e-9)).unwrap();
+        let left = m
+            .select_nodes(&Range::plane([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], 1e-9))
+            .unwrap();
         assert_eq!(left, vec![0, 3]);
         m.add_node_group("left", left).unwrap();
-        let sel = m.select_nodes(&Range::group("left").or(Range::Ball { center: [1.0, 1.0, 0.0], radius: 0.1 })).unwrap();
+        let sel = m
+            .select_nodes(&Range::group("left").or(Range::Ball {
+                center: [1.0, 1.0, 0.0],
+                radius: 0.1,
+            }))
+            .unwrap();
         assert_eq!(sel, vec![0, 2, 3]);
-        let top = m.select_boundary_faces(&Range::rect(-1.0, 0.9, 2.0, 1.1)).unwrap();
+        let top = m
+            .select_boundary_faces(&Range::rect(-1.0, 0.9, 2.0, 1.1))
+            .unwrap();
         assert_eq!(m.nodes_of_faces(&top), vec![2, 3]);
         let custom = m.select_elements(&Range::custom(|x| x[0] > x[1])).unwrap();
         assert_eq!(custom, vec![0]);
-        assert!(matches!(m.select_nodes(&Range::group("nope")), Err(MeshError::UnknownGroup { .. })));
-        assert!(m.select_nodes(&Range::plane([0.0; 3], [0.0; 3], 1.0)).is_err());
+        assert!(matches!(
+            m.select_nodes(&Range::group("nope")),
+            Err(MeshError::UnknownGroup { .. })
+        ));
+        assert!(m
+            .select_nodes(&Range::plane([0.0; 3], [0.0; 3], 1.0))
+            .is_err());
         assert!(m.add_node_group("bad", vec![99]).is_err());
     }
 }

@@ -84,7 +84,10 @@ impl Range {
 
     /// A 2D box `[x0, x1] x [y0, y1]`.
     pub fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Self {
-        Range::Box { min: [x0, y0, f64::NEG_INFINITY], max: [x1, y1, f64::INFINITY] }
+        Range::Box {
+            min: [x0, y0, f64::NEG_INFINITY],
+            max: [x1, y1, f64::INFINITY],
+        }
     }
 
     /// A 3D box.
@@ -121,7 +124,9 @@ impl Range {
     pub fn validate(&self) -> Result<(), crate::MeshError> {
         let bad = |s: String| Err(crate::MeshError::InvalidRange(s));
         match self {
-            Range::Ball { radius, .. } if radius.is_nan() || *radius < 0.0 => bad(format!("ball radius {radius}")),
+            Range::Ball { radius, .. } if radius.is_nan() || *radius < 0.0 => {
+                bad(format!("ball radius {radius}"))
+            }
             Range::Plane { normal, tol, .. } => {
                 if tol.is_nan() || *tol < 0.0 {
                     return bad(format!("plane tolerance {tol}"));

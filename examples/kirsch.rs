@@ -1,0 +1,100 @@
+//! Validation scene 1 (Kirsch): a circular hole under far-field stress, solved by the
+//! direct sparse solve and by dynamic relaxation at three mesh sizes.
+//!
+//! `cargo run --release --example kirsch` prints an error table, writes
+//! `out/kirsch/kirsch.png` and ends with one RESULT line per solver.
+
+use pcdc::plot::Plot;
+use pcdc::report::{out_dir, ResultLine};
+use pcdc::scenes::kirsch::{self, Params, Solver};
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let full = Params::full();
+    println!("Kirsch: hole radius a = {} m, ring to 25a, E = 50 GPa, nu = 0.25, P1 = 10 MPa (x), P2 = 5 MPa (y)", full.radius);
+    println!(
+        "{:>10} {:>10} {:>9} {:>10} {:>8} {:>9}",
+        "solver", "size/a", "elements", "error", "steps", "wall_s"
+    );
+    let mut finals = Vec::new();
+    for solver in [Solver::Direct, Solver::Relaxation] {
+        for size in [0.1, 0.05, full.size_at_hole] {
+            let p = Params {
+                size_at_hole: size,
+                ..full.clone()
+            };
+            let out = kirsch::run(&p, solver)?;
+            println!(
+                "{:>10} {:>10.3} {:>9} {:>10.4} {:>8} {:>9.3}",
+                solver.name(),
+                size,
+                out.elements,
+                out.error,
+                out.steps,
+                out.wall_s
+            );
+            if size == full.size_at_hole {
+                finals.push(out);
+            }
+        }
+    }
+    let a = full.radius;
+    let rs: Vec<f64> = (0..200).map(|i| 1.0 + 4.0 * i as f64 / 199.0).collect();
+    let mut plot = Plot::new(
+        "Kirsch: stresses along θ = 0 (compression positive)",
+        "r / a",
+        "stress (MPa)",
+    )
+    .line(
+        "σθ exact (eq. 49)",
+        rs.clone(),
+        rs.iter().map(|r| kirsch::exact(r * a, a).0 / 1e6).collect(),
+    )
+    .line(
+        "σr exact (eq. 50)",
+        rs.clone(),
+        rs.iter().map(|r| kirsch::exact(r * a, a).1 / 1e6).collect(),
+    );
+    for out in &finals {
+        plot = plot
+            .points(
+                format!("σθ {}", out.solver.name()),
+                out.r_over_a.clone(),
+                out.sigma_theta.iter().map(|s| s / 1e6).collect(),
+            )
+            .points(
+                format!("σr {}", out.solver.name()),
+                out.r_over_a.clone(),
+                out.sigma_r.iter().map(|s| s / 1e6).collect(),
+            );
+    }
+    let png = out_dir("kirsch")?.join("kirsch.png");
+    plot.save_png(&png)?;
+    println!("plot: {}", png.display());
+    let mut all_pass = true;
+    for out in &finals {
+        let line = ResultLine {
+            case: "kirsch".into(),
+            metric: format!("max_rel_err_{}", out.solver.name()),
+            value: out.error,
+            tol: kirsch::TOL,
+            elements: out.elements,
+            steps: out.steps,
+            wall_s: out.wall_s,
+            backend: "cpu".into(),
+            precision: "f64".into(),
+        };
+        all_pass &= line.pass();
+        println!("{line}");
+    }
+    if !all_pass {
+        std::process::exit(2);
+    }
+    Ok(())
+}

@@ -1,0 +1,92 @@
+//! Validation scene 4: energy of an undamped free vibration over ten periods, 2D and 3D,
+//! three mesh sizes.
+//!
+//! `cargo run --release --example vibration_energy` prints a drift table, writes
+//! `out/vibration_energy/vibration_energy.png` and ends with the RESULT line (worst of
+//! 2D and 3D at the finest size).
+
+use pcdc::plot::Plot;
+use pcdc::report::{out_dir, ResultLine};
+use pcdc::scenes::vibration_energy::{self, Params};
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let full = Params::full();
+    println!(
+        "Undamped free vibration of an elastic block, {} periods of its first extensional mode",
+        full.periods
+    );
+    println!(
+        "{:>4} {:>8} {:>9} {:>11} {:>8} {:>8}",
+        "dim", "size_m", "elements", "drift", "steps", "wall_s"
+    );
+    let mut finals = Vec::new();
+    for size in [4.0 * full.size, 2.0 * full.size, full.size] {
+        let p = Params {
+            size,
+            ..full.clone()
+        };
+        for (dim, out) in [
+            ("2d", vibration_energy::run_2d(&p)?),
+            ("3d", vibration_energy::run_3d(&p)?),
+        ] {
+            println!(
+                "{:>4} {:>8.4} {:>9} {:>11.3e} {:>8} {:>8.3}",
+                dim, size, out.elements, out.drift, out.steps, out.wall_s
+            );
+            if size == full.size {
+                finals.push((dim, out));
+            }
+        }
+    }
+    let mut plot = Plot::new(
+        "Undamped vibration: energy / initial energy",
+        "t / T",
+        "E / E0",
+    );
+    for (dim, out) in &finals {
+        let stride = (out.t_over_period.len() / 400).max(1);
+        let t: Vec<f64> = out.t_over_period.iter().step_by(stride).copied().collect();
+        plot = plot
+            .points(
+                format!("total {dim}"),
+                t.clone(),
+                out.energy.iter().step_by(stride).copied().collect(),
+            )
+            .line(
+                format!("strain {dim}"),
+                t,
+                out.strain_energy.iter().step_by(stride).copied().collect(),
+            );
+    }
+    plot = plot.line("exact total", vec![0.0, full.periods], vec![1.0, 1.0]);
+    let png = out_dir("vibration_energy")?.join("vibration_energy.png");
+    plot.save_png(&png)?;
+    println!("plot: {}", png.display());
+    let worst = finals
+        .iter()
+        .max_by(|a, b| a.1.drift.total_cmp(&b.1.drift))
+        .expect("two runs");
+    let line = ResultLine {
+        case: "vibration_energy".into(),
+        metric: "max_rel_energy_drift".into(),
+        value: worst.1.drift,
+        tol: vibration_energy::TOL,
+        elements: finals.iter().map(|f| f.1.elements).sum(),
+        steps: finals.iter().map(|f| f.1.steps).sum(),
+        wall_s: finals.iter().map(|f| f.1.wall_s).sum(),
+        backend: "cpu".into(),
+        precision: "f64".into(),
+    };
+    println!("{line}");
+    if !line.pass() {
+        std::process::exit(2);
+    }
+    Ok(())
+}

@@ -1,0 +1,89 @@
+//! Validation scene 3: P-wave speed in a bar on rollers, 2D and 3D, three mesh sizes.
+//!
+//! `cargo run --release --example wave_speed` prints an error table, writes
+//! `out/wave_speed/wave_speed.png` (probe velocities against time, with the analytic
+//! arrival times) and ends with the RESULT line (worst of 2D and 3D at the finest size).
+
+use pcdc::plot::Plot;
+use pcdc::report::{out_dir, ResultLine};
+use pcdc::scenes::wave_speed::{self, Params};
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let full = Params::full();
+    println!(
+        "P-wave speed, bar 1 m on rollers, E = 30 GPa, nu = 0.25, rho = 2600: c = {:.2} m/s",
+        wave_speed::c_exact()
+    );
+    println!(
+        "{:>4} {:>8} {:>9} {:>10} {:>9} {:>7} {:>8}",
+        "dim", "size_m", "elements", "c_num", "error", "steps", "wall_s"
+    );
+    let mut finals = Vec::new();
+    for size in [4.0 * full.size, 2.0 * full.size, full.size] {
+        let p = Params {
+            size,
+            ..full.clone()
+        };
+        for (dim, out) in [
+            ("2d", wave_speed::run_2d(&p)?),
+            ("3d", wave_speed::run_3d(&p)?),
+        ] {
+            println!(
+                "{:>4} {:>8.4} {:>9} {:>10.2} {:>9.5} {:>7} {:>8.3}",
+                dim, size, out.elements, out.c_num, out.error, out.steps, out.wall_s
+            );
+            if size == full.size {
+                finals.push((dim, out));
+            }
+        }
+    }
+    let c = wave_speed::c_exact();
+    let (_, o2) = &finals[0];
+    let tmax = o2.t.last().copied().unwrap_or(0.0) * 1e3;
+    let step = |x: f64| -> (Vec<f64>, Vec<f64>) {
+        let ta = x / c * 1e3;
+        (vec![0.0, ta, ta, tmax], vec![0.0, 0.0, 0.1, 0.1])
+    };
+    let (sx1, sy1) = step(0.25);
+    let (sx2, sy2) = step(0.75);
+    let ms: Vec<f64> = o2.t.iter().map(|t| t * 1e3).collect();
+    let plot = Plot::new(
+        "Velocity step in a bar on rollers (2D)",
+        "time (ms)",
+        "mean x-velocity (m/s)",
+    )
+    .line("exact front at x = 0.25 m", sx1, sy1)
+    .line("exact front at x = 0.75 m", sx2, sy2)
+    .points("FDEM x = 0.25 m", ms.clone(), o2.v1.clone())
+    .points("FDEM x = 0.75 m", ms, o2.v2.clone());
+    let png = out_dir("wave_speed")?.join("wave_speed.png");
+    plot.save_png(&png)?;
+    println!("plot: {}", png.display());
+    let worst = finals
+        .iter()
+        .max_by(|a, b| a.1.error.total_cmp(&b.1.error))
+        .expect("two runs");
+    let line = ResultLine {
+        case: "wave_speed".into(),
+        metric: "rel_err_p_wave_speed".into(),
+        value: worst.1.error,
+        tol: wave_speed::TOL,
+        elements: finals.iter().map(|f| f.1.elements).sum(),
+        steps: finals.iter().map(|f| f.1.steps).sum(),
+        wall_s: finals.iter().map(|f| f.1.wall_s).sum(),
+        backend: "cpu".into(),
+        precision: "f64".into(),
+    };
+    println!("{line}");
+    if !line.pass() {
+        std::process::exit(2);
+    }
+    Ok(())
+}

@@ -1,0 +1,85 @@
+//! The `RESULT` line every validation scene ends with (DESIGN.md), and output folders.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// One machine-readable result line:
+/// `RESULT case=<name> metric=<name> value=<number> tol=<number> pass=<bool> elements=<n>
+/// steps=<n> wall_s=<seconds> backend=<cpu|gpu> precision=<f64|f32>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ResultLine {
+    /// Scene name.
+    pub case: String,
+    /// Name of the error metric.
+    pub metric: String,
+    /// Measured value of the metric.
+    pub value: f64,
+    /// Tolerance.
+    pub tol: f64,
+    /// Elements in the model.
+    pub elements: usize,
+    /// Steps (explicit steps, relaxation steps or solver iterations).
+    pub steps: u64,
+    /// Wall-clock time of the solve (s).
+    pub wall_s: f64,
+    /// Backend name.
+    pub backend: String,
+    /// Floating-point precision.
+    pub precision: String,
+}
+
+impl ResultLine {
+    /// Whether the value is within tolerance.
+    pub fn pass(&self) -> bool {
+        self.value.is_finite() && self.value <= self.tol
+    }
+}
+
+impl fmt::Display for ResultLine {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "RESULT case={} metric={} value={:.6e} tol={} pass={} elements={} steps={} wall_s={:.3} backend={} precision={}",
+            self.case,
+            self.metric,
+            self.value,
+            self.tol,
+            self.pass(),
+            self.elements,
+            self.steps,
+            self.wall_s,
+            self.backend,
+            self.precision
+        )
+    }
+}
+
+/// `out/<case>` under the current directory, created if missing.
+pub fn out_dir(case: &str) -> std::io::Result<PathBuf> {
+    let dir = PathBuf::from("out").join(case);
+    std::fs::create_dir_all(&dir)?;
+    Ok(dir)
+}
+
+/// Errors of the validation scenes.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// Mesh error.
+    #[error(transparent)]
+    Mesh(#[from] pcdc_mesh::MeshError),
+    /// Compute error.
+    #[error(transparent)]
+    Compute(#[from] pcdc_compute::ComputeError),
+    /// Mechanics error.
+    #[error(transparent)]
+    Mech(#[from] pcdc_mech::MechError),
+    /// Plot error.
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
+    /// Input/output error.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// The scene could not measure what it compares (e.g. a probe saw no wave front).
+    #[error("{0}")]
+    Measurement(String),
+}

@@ -1,0 +1,52 @@
+//! Reduced-size validation scenes: the same tolerances as the full examples.
+
+use pcdc::scenes::{kirsch, vibration_energy, wave_speed};
+
+#[test]
+fn kirsch_direct_and_relaxation_within_3_percent() {
+    for solver in [kirsch::Solver::Direct, kirsch::Solver::Relaxation] {
+        let out = kirsch::run(&kirsch::Params::reduced(), solver).unwrap();
+        eprintln!(
+            "kirsch {:?}: error {:.4} elements {} steps {} wall {:.2}s",
+            solver, out.error, out.elements, out.steps, out.wall_s
+        );
+        assert!(out.error <= kirsch::TOL, "{solver:?}: error {}", out.error);
+    }
+}
+
+#[test]
+fn wave_speed_within_2_percent_2d_and_3d() {
+    let p = wave_speed::Params::reduced();
+    for (name, out) in [
+        ("2d", wave_speed::run_2d(&p).unwrap()),
+        ("3d", wave_speed::run_3d(&p).unwrap()),
+    ] {
+        eprintln!(
+            "wave {name}: c_num {:.1} c {:.1} error {:.4} elements {} steps {}",
+            out.c_num, out.c_exact, out.error, out.elements, out.steps
+        );
+        assert!(out.error <= wave_speed::TOL, "{name}: {}", out.error);
+    }
+}
+
+#[test]
+fn vibration_energy_drift_below_half_percent_2d_and_3d() {
+    let p = vibration_energy::Params::reduced();
+    for (name, out) in [
+        ("2d", vibration_energy::run_2d(&p).unwrap()),
+        ("3d", vibration_energy::run_3d(&p).unwrap()),
+    ] {
+        eprintln!(
+            "energy {name}: drift {:.2e} elements {} steps {}",
+            out.drift, out.elements, out.steps
+        );
+        assert!(out.drift <= vibration_energy::TOL, "{name}: {}", out.drift);
+        // The block really vibrates: strain energy swings between near zero and E0.
+        let min_se = out
+            .strain_energy
+            .iter()
+            .cloned()
+            .fold(f64::INFINITY, f64::min);
+        assert!(min_se < 0.2, "strain energy never released: {min_se}");
+    }
+}
