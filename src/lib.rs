@@ -5,6 +5,8 @@
 //! plotting used by the validation scenes.
 
 #![warn(missing_docs)]
+// Index loops mirror the tensor notation of the manual's equations.
+#![allow(clippy::needless_range_loop)]
 
 pub use pcdc_compute as compute;
 pub use pcdc_mech as mech;

@@ -7,6 +7,9 @@ use pcdc_mesh::Dim;
 
 use crate::{Backend, ComputeError, Simulation};
 
+/// A user function sampled by [`Probe::Custom`].
+pub type ProbeFn<D, B> = Box<dyn Fn(&Simulation<D, B>) -> f64 + Send + Sync>;
+
 /// A quantity sampled by a [`History`].
 pub enum Probe<D: Dim, B: Backend> {
     /// Simulation time (s).
@@ -39,7 +42,7 @@ pub enum Probe<D: Dim, B: Backend> {
     /// Stored (e.g. strain) energy (J).
     StoredEnergy,
     /// Any quantity computed from the simulation.
-    Custom(Box<dyn Fn(&Simulation<D, B>) -> f64 + Send + Sync>),
+    Custom(ProbeFn<D, B>),
 }
 
 /// Probes sampled into columns, written as CSV (one header line, one row per sample).
@@ -73,14 +76,18 @@ impl<D: Dim, B: Backend> History<D, B> {
     pub fn validate(&self, sim: &Simulation<D, B>) -> Result<(), ComputeError> {
         for (name, p) in &self.columns {
             match p {
-                Probe::NodeDisplacement { node, comp } | Probe::NodeVelocity { node, comp } => {
-                    if *node as usize >= sim.mesh().n_nodes() || *comp >= D::D {
-                        return Err(ComputeError::param(
-                            format!("probe '{name}'"),
-                            format!("node {node} comp {comp}"),
-                            "out of range",
-                        ));
-                    }
+                Probe::NodeDisplacement { node, comp } | Probe::NodeVelocity { node, comp }
+                    if *node as usize >= sim.mesh().n_nodes() || *comp >= D::D =>
+                {
+                    return Err(ComputeError::param(
+                        format!("probe '{name}'"),
+                        format!("node {node} comp {comp}"),
+                        format!(
+                            "out of range ({} nodes, {} components)",
+                            sim.mesh().n_nodes(),
+                            D::D
+                        ),
+                    ));
                 }
                 Probe::Field { field, index, comp } => {
                     let id = sim.state.fields.id(field)?;
@@ -103,8 +110,11 @@ impl<D: Dim, B: Backend> History<D, B> {
         Ok(())
     }
 
-    /// Samples every probe now.
+    /// Samples every probe now (the probes are checked at the first sample).
     pub fn sample(&mut self, sim: &Simulation<D, B>) -> Result<(), ComputeError> {
+        if self.rows.is_empty() {
+            self.validate(sim)?;
+        }
         let d = D::D;
         let mut row = Vec::with_capacity(self.columns.len());
         for (_, p) in &self.columns {

@@ -12,6 +12,8 @@
 //! once per node; each node sums its slots in registration order.
 
 #![warn(missing_docs)]
+// Index loops mirror the tensor notation of the manual's equations.
+#![allow(clippy::needless_range_loop)]
 
 mod backend;
 mod error;

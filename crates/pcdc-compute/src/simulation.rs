@@ -157,7 +157,7 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             .sum::<f64>()
             .sqrt();
         let runaway = runaway.unwrap_or(100.0 * diag);
-        if !(runaway > 0.0) {
+        if runaway.is_nan() || runaway <= 0.0 {
             return Err(ComputeError::param(
                 "runaway_displacement",
                 runaway,

@@ -248,7 +248,7 @@ impl<D: Dim> Simulation<D, CpuBackend> {
 }
 
 fn check_opts(opts: &StaticOptions) -> Result<(), ComputeError> {
-    if !(opts.tolerance > 0.0) {
+    if opts.tolerance.is_nan() || opts.tolerance <= 0.0 {
         return Err(ComputeError::param(
             "tolerance",
             opts.tolerance,

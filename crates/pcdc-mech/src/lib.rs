@@ -24,6 +24,8 @@
 //! ```
 
 #![warn(missing_docs)]
+// Index loops mirror the tensor notation of the manual's equations.
+#![allow(clippy::needless_range_loop)]
 
 pub mod actions;
 mod boundary;

@@ -554,3 +554,62 @@ fn initial_stress_is_kept_in_equilibrium() {
     assert!(max_abs(&sim.state.u) < 1e-15, "{}", max_abs(&sim.state.u));
     let _ = Dim2::NAME;
 }
+
+#[test]
+fn history_csv_and_vtu_series() {
+    use pcdc_compute::{History, Probe};
+    let dir = std::env::temp_dir().join(format!("pcdc-hist-{}", std::process::id()));
+    let mut sim = loaded_block(1);
+    let top = sim.mesh().select_nodes(&Range::group("top")).unwrap()[0];
+    let mut hist = History::new()
+        .probe("t", Probe::Time)
+        .probe("uy_top", Probe::NodeDisplacement { node: top, comp: 1 })
+        .probe(
+            "syy_e0",
+            Probe::Field {
+                field: "stress".into(),
+                index: 0,
+                comp: 1,
+            },
+        )
+        .probe("ke", Probe::KineticEnergy)
+        .probe("two_t", Probe::Custom(Box::new(|s| 2.0 * s.state.time)));
+    let mut series = pcdc_mesh::vtu::PvdSeries::new(&dir, "block").unwrap();
+    for _ in 0..5 {
+        sim.run(20).unwrap();
+        hist.sample(&sim).unwrap();
+        output::write_step(&mut series, &sim).unwrap();
+    }
+    let csv = dir.join("hist.csv");
+    hist.write_csv(&csv).unwrap();
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[0], "t,uy_top,syy_e0,ke,two_t");
+    assert_eq!(lines.len(), 6);
+    let last: Vec<f64> = lines[5].split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(last[0], sim.state.time);
+    assert_eq!(last[1], sim.state.u[2 * top as usize + 1]);
+    assert_eq!(last[4], 2.0 * sim.state.time);
+    assert!(last[1] < 0.0, "top pushed down");
+    let pvd = std::fs::read_to_string(dir.join("block.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 5);
+    // A probe on a node that does not exist is an error, not a panic.
+    let mut bad = History::new().probe(
+        "x",
+        Probe::NodeVelocity {
+            node: 1_000_000,
+            comp: 0,
+        },
+    );
+    assert!(bad.sample(&sim).is_err());
+    let mut bad = History::new().probe(
+        "x",
+        Probe::Field {
+            field: "pressure".into(),
+            index: 0,
+            comp: 0,
+        },
+    );
+    assert!(bad.sample(&sim).is_err());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -8,6 +8,8 @@
 //! Units are SI throughout: coordinates in metres.
 
 #![warn(missing_docs)]
+// Index loops mirror the tensor notation of the manual's equations.
+#![allow(clippy::needless_range_loop)]
 
 mod dim;
 mod error;
