@@ -2,7 +2,9 @@
 //! direct sparse solve and by dynamic relaxation at three mesh sizes.
 //!
 //! `cargo run --release --example kirsch` prints an error table, writes
-//! `out/kirsch/kirsch.png` and ends with one RESULT line per solver.
+//! `out/kirsch/kirsch.png` and the finest solutions as `out/kirsch/kirsch_*.pvd`
+//! (open in ParaView: displacement, stress, principal stresses), and ends with one
+//! RESULT line per solver.
 
 use pcdc::plot::Plot;
 use pcdc::report::{out_dir, ResultLine};
@@ -25,8 +27,12 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let mut finals = Vec::new();
     for solver in [Solver::Direct, Solver::Relaxation] {
         for size in [0.1, 0.05, full.size_at_hole] {
+            let vtu_dir = (size == full.size_at_hole)
+                .then(|| out_dir("kirsch"))
+                .transpose()?;
             let p = Params {
                 size_at_hole: size,
+                vtu_dir,
                 ..full.clone()
             };
             let out = kirsch::run(&p, solver)?;

@@ -1,8 +1,35 @@
 //! # pcdc
 //!
 //! Facade of the pcdc-rs SDK for continuum–discontinuum geomechanics by the combined
-//! finite–discrete element method (FDEM): re-exports the crates and holds the PNG
-//! plotting used by the validation scenes.
+//! finite–discrete element method (FDEM): re-exports the crates ([`mesh`], [`compute`],
+//! [`mech`]), holds the validation [`scenes`], their [`report`] lines and the PNG
+//! [`plot`]s.
+//!
+//! A static scene in a few lines (the README's example):
+//!
+//! ```
+//! use pcdc::compute::{CpuBackend, Simulation, StaticOptions};
+//! use pcdc::mech::{output, Boundary, FaceStress, LinearElastic, Mechanics};
+//! use pcdc::mesh::{builders, Range};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let mesh = builders::rectangle(0.0, 0.0, 1.0, 2.0, 0.25)?;
+//! let rock = LinearElastic::new(30e9, 0.25, 2600.0)?.with_damping(1.0)?;
+//! let mut sim = Simulation::builder(mesh, CpuBackend::new(0)?)
+//!     .physics(Mechanics::new().material(Range::All, rock))
+//!     .physics(
+//!         Boundary::new()
+//!             .fix(Range::group("bottom"))
+//!             .face_stress(Range::group("top"), FaceStress::normal(-1e6)), // 1 MPa pressure
+//!     )
+//!     .gravity([0.0, -9.81, 0.0])
+//!     .build()?;
+//! sim.solve_linear(&StaticOptions::default())?; // or sim.relax(..), or sim.run(steps)
+//! let stress = output::global_stress(&sim)?; // Pa, tension positive
+//! assert!(stress.iter().all(|s| s.is_finite()));
+//! # Ok(())
+//! # }
+//! ```
 
 #![warn(missing_docs)]
 // Index loops mirror the tensor notation of the manual's equations.

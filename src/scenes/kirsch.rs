@@ -57,6 +57,8 @@ pub struct Params {
     pub size_at_hole: f64,
     /// Worker threads (0 = all cores).
     pub threads: usize,
+    /// Folder for a VTU/PVD file of the solution (ParaView), if any.
+    pub vtu_dir: Option<std::path::PathBuf>,
 }
 
 impl Params {
@@ -66,6 +68,7 @@ impl Params {
             radius: 0.1,
             size_at_hole: 0.025,
             threads: 0,
+            vtu_dir: None,
         }
     }
     /// Reduced size for tests (a/20 at the hole).
@@ -74,6 +77,7 @@ impl Params {
             radius: 0.1,
             size_at_hole: 0.05,
             threads: 2,
+            vtu_dir: None,
         }
     }
 }
@@ -181,6 +185,10 @@ pub fn run(p: &Params, solver: Solver) -> Result<Outcome, SceneError> {
     };
     let stress = output::global_stress(&sim)?;
     let wall_s = start.elapsed().as_secs_f64();
+    if let Some(dir) = &p.vtu_dir {
+        let mut series = pcdc_mesh::vtu::PvdSeries::new(dir, &format!("kirsch_{}", solver.name()))?;
+        output::write_step(&mut series, &sim)?;
+    }
     let nodal = output::nodal_average(sim.mesh(), &stress, 3);
     let mesh = sim.mesh();
     let mut samples: Vec<(f64, f64, f64)> = (0..mesh.n_nodes())

@@ -7,6 +7,23 @@
 //! (velocities, accelerations, forces, face stresses, move constraints), initial stress,
 //! and the resets of 7.2.8.
 //!
+//! ## Equations implemented
+//!
+//! | manual | what | where |
+//! | --- | --- | --- |
+//! | 7.1 i–v | explicit central differences `v += dt F/m`, `u += dt v` | `pcdc_compute::Simulation` |
+//! | eq. 1–11 | constant element strain; here its large-rotation form: `F = D_s D_m⁻¹`, `F = R U`, `ε = U − I` | [`kinematics`] |
+//! | eq. 12 | `σ(t+Δt) = H(σ(t), ε, Δε, history)` | [`ConstitutiveModel::update`] |
+//! | eq. 13–14 | nodal forces from the element stress, `f_a = −V₀ R σ ∇N_a` | `Mechanics` |
+//! | eq. 15–16 | body force and lumped mass `ρV/(N+1)` per node | `Mechanics`, gravity in `Simulation` |
+//! | eq. 17–19 | viscous stress `σ_v = D_f C ε̇`, `C = 2L√(ρE)`, L = mean edge length | `Mechanics` |
+//! | eq. 20–24 | isotropic linear elasticity, λ and μ from E, ν (or K, G) | [`LinearElastic`] |
+//! | tables 4–7 | velocity/acceleration, force, face stress, move constraints | [`Boundary`] |
+//!
+//! The stable step of an element is `κ h / c_p` with h its smallest height, c_p the
+//! P-wave speed and κ = 0.8 (Tri3) or 0.45 (Tet4) from the element eigenvalues; with
+//! damping it is reduced to `(2/ω)(√(1+ξ²) − ξ)`.
+//!
 //! ```
 //! use pcdc_compute::{CpuBackend, Simulation};
 //! use pcdc_mech::{Boundary, LinearElastic, Mechanics};
