@@ -11,13 +11,10 @@ use pcdc::report::{out_dir, ResultLine};
 use pcdc::scenes::kirsch::{self, Params, Solver};
 
 fn main() {
-    if let Err(e) = run() {
-        eprintln!("error: {e}");
-        std::process::exit(1);
-    }
+    pcdc::report::finish(run())
 }
 
-fn run() -> Result<(), Box<dyn std::error::Error>> {
+fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
     let full = Params::full();
     println!("Kirsch: hole radius a = {} m, ring to 25a, E = 50 GPa, nu = 0.25, P1 = 10 MPa (x), P2 = 5 MPa (y)", full.radius);
     println!(
@@ -83,24 +80,18 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let png = out_dir("kirsch")?.join("kirsch.png");
     plot.save_png(&png)?;
     println!("plot: {}", png.display());
-    let mut all_pass = true;
-    for out in &finals {
-        let line = ResultLine {
-            case: "kirsch".into(),
-            metric: format!("max_rel_err_{}", out.solver.name()),
-            value: out.error,
-            tol: kirsch::TOL,
-            elements: out.elements,
-            steps: out.steps,
-            wall_s: out.wall_s,
-            backend: "cpu".into(),
-            precision: "f64".into(),
-        };
-        all_pass &= line.pass();
-        println!("{line}");
-    }
-    if !all_pass {
-        std::process::exit(2);
-    }
-    Ok(())
+    Ok(finals
+        .iter()
+        .map(|out| {
+            ResultLine::cpu(
+                "kirsch",
+                &format!("max_rel_err_{}", out.solver.name()),
+                out.error,
+                kirsch::TOL,
+                out.elements,
+                out.steps,
+                out.wall_s,
+            )
+        })
+        .collect())
 }

@@ -10,13 +10,10 @@ use pcdc::report::{out_dir, ResultLine};
 use pcdc::scenes::vibration_energy::{self, Params};
 
 fn main() {
-    if let Err(e) = run() {
-        eprintln!("error: {e}");
-        std::process::exit(1);
-    }
+    pcdc::report::finish(run())
 }
 
-fn run() -> Result<(), Box<dyn std::error::Error>> {
+fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
     let full = Params::full();
     println!(
         "Undamped free vibration of an elastic block, {} periods of its first extensional mode",
@@ -73,20 +70,13 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .max_by(|a, b| a.1.drift.total_cmp(&b.1.drift))
         .expect("two runs");
-    let line = ResultLine {
-        case: "vibration_energy".into(),
-        metric: "max_rel_energy_drift".into(),
-        value: worst.1.drift,
-        tol: vibration_energy::TOL,
-        elements: finals.iter().map(|f| f.1.elements).sum(),
-        steps: finals.iter().map(|f| f.1.steps).sum(),
-        wall_s: finals.iter().map(|f| f.1.wall_s).sum(),
-        backend: "cpu".into(),
-        precision: "f64".into(),
-    };
-    println!("{line}");
-    if !line.pass() {
-        std::process::exit(2);
-    }
-    Ok(())
+    Ok(vec![ResultLine::cpu(
+        "vibration_energy",
+        "max_rel_energy_drift",
+        worst.1.drift,
+        vibration_energy::TOL,
+        finals.iter().map(|f| f.1.elements).sum(),
+        finals.iter().map(|f| f.1.steps).sum(),
+        finals.iter().map(|f| f.1.wall_s).sum(),
+    )])
 }

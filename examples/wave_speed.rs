@@ -9,13 +9,10 @@ use pcdc::report::{out_dir, ResultLine};
 use pcdc::scenes::wave_speed::{self, Params};
 
 fn main() {
-    if let Err(e) = run() {
-        eprintln!("error: {e}");
-        std::process::exit(1);
-    }
+    pcdc::report::finish(run())
 }
 
-fn run() -> Result<(), Box<dyn std::error::Error>> {
+fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
     let full = Params::full();
     println!(
         "P-wave speed, bar 1 m on rollers, E = 30 GPa, nu = 0.25, rho = 2600: c = {:.2} m/s",
@@ -70,20 +67,13 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .max_by(|a, b| a.1.error.total_cmp(&b.1.error))
         .expect("two runs");
-    let line = ResultLine {
-        case: "wave_speed".into(),
-        metric: "rel_err_p_wave_speed".into(),
-        value: worst.1.error,
-        tol: wave_speed::TOL,
-        elements: finals.iter().map(|f| f.1.elements).sum(),
-        steps: finals.iter().map(|f| f.1.steps).sum(),
-        wall_s: finals.iter().map(|f| f.1.wall_s).sum(),
-        backend: "cpu".into(),
-        precision: "f64".into(),
-    };
-    println!("{line}");
-    if !line.pass() {
-        std::process::exit(2);
-    }
-    Ok(())
+    Ok(vec![ResultLine::cpu(
+        "wave_speed",
+        "rel_err_p_wave_speed",
+        worst.1.error,
+        wave_speed::TOL,
+        finals.iter().map(|f| f.1.elements).sum(),
+        finals.iter().map(|f| f.1.steps).sum(),
+        finals.iter().map(|f| f.1.wall_s).sum(),
+    )])
 }

@@ -29,6 +29,29 @@ pub struct ResultLine {
 }
 
 impl ResultLine {
+    /// A result measured on the CPU backend in f64.
+    pub fn cpu(
+        case: &str,
+        metric: &str,
+        value: f64,
+        tol: f64,
+        elements: usize,
+        steps: u64,
+        wall_s: f64,
+    ) -> Self {
+        ResultLine {
+            case: case.into(),
+            metric: metric.into(),
+            value,
+            tol,
+            elements,
+            steps,
+            wall_s,
+            backend: "cpu".into(),
+            precision: "f64".into(),
+        }
+    }
+
     /// Whether the value is within tolerance.
     pub fn pass(&self) -> bool {
         self.value.is_finite() && self.value <= self.tol
@@ -51,6 +74,27 @@ impl fmt::Display for ResultLine {
             self.backend,
             self.precision
         )
+    }
+}
+
+/// Ends a validation example: prints its RESULT lines last and exits with status 0 when
+/// all pass, 2 when one fails, and 1 (after printing the error) when the run failed.
+pub fn finish(result: Result<Vec<ResultLine>, Box<dyn std::error::Error>>) -> ! {
+    match result {
+        Ok(lines) => {
+            for l in &lines {
+                println!("{l}");
+            }
+            std::process::exit(if lines.iter().all(ResultLine::pass) {
+                0
+            } else {
+                2
+            })
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::exit(1)
+        }
     }
 }
 

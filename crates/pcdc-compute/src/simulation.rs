@@ -534,6 +534,19 @@ impl<D: Dim> Simulation<D, CpuBackend> {
 }
 
 impl<D: Dim, B: Backend> Simulation<D, B> {
+    /// Read-only view of the current kinematic state.
+    pub fn kinematics(&self) -> Kinematics<'_, D> {
+        Kinematics {
+            mesh: &self.mesh,
+            u: &self.state.u,
+            v: &self.state.v,
+            time: self.state.time,
+            dt: self.dt,
+            step: self.state.step,
+            damping: self.damping,
+        }
+    }
+
     /// The mesh.
     pub fn mesh(&self) -> &Mesh<D> {
         &self.mesh
@@ -576,15 +589,7 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
     /// Recomputes the stable time step from the current state (e.g. after large
     /// deformation) unless a fixed step was set.
     pub fn update_time_step(&mut self) -> Result<(), ComputeError> {
-        let kin = Kinematics {
-            mesh: &self.mesh,
-            u: &self.state.u,
-            v: &self.state.v,
-            time: self.state.time,
-            dt: self.dt,
-            step: self.state.step,
-            damping: self.damping,
-        };
+        let kin = self.kinematics();
         let mut best: Option<StableStep> = None;
         for p in &self.physics {
             if let Some(s) = p.stable_step(&kin, &self.state.fields) {
@@ -626,15 +631,7 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
 
     /// Energy stored by all physics (J), e.g. elastic strain energy.
     pub fn stored_energy(&self) -> f64 {
-        let kin = Kinematics {
-            mesh: &self.mesh,
-            u: &self.state.u,
-            v: &self.state.v,
-            time: self.state.time,
-            dt: self.dt,
-            step: self.state.step,
-            damping: self.damping,
-        };
+        let kin = self.kinematics();
         self.physics
             .iter()
             .map(|p| p.stored_energy(&kin, &self.state.fields))

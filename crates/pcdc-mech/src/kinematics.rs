@@ -9,6 +9,28 @@
 //! first Piola-Kirchhoff stress `P = R σ`: `f_a = -V₀ P ∇N_a` (the large-rotation form of
 //! eq. 14).
 
+/// Inverse of the 2D reference edge matrix `D_m = [x₁ − x₀, x₂ − x₀]` (columns) of a
+/// triangle with vertex coordinates `x` (6 values), row-major; row j is ∇N_{j+1}.
+#[inline]
+pub fn dm_inv_2d(x: &[f64]) -> [f64; 4] {
+    let (a, b, c, d) = (x[2] - x[0], x[4] - x[0], x[3] - x[1], x[5] - x[1]);
+    let det = a * d - b * c;
+    [d / det, -b / det, -c / det, a / det]
+}
+
+/// Deformation gradient `F = D_s D_m⁻¹` (row-major 2x2) of a triangle with current
+/// vertex coordinates `x` (6 values).
+#[inline]
+pub fn deformation_gradient_2d(x: &[f64; 6], m: &[f64]) -> [f64; 4] {
+    let ds = [x[2] - x[0], x[4] - x[0], x[3] - x[1], x[5] - x[1]];
+    [
+        ds[0] * m[0] + ds[1] * m[2],
+        ds[0] * m[1] + ds[1] * m[3],
+        ds[2] * m[0] + ds[3] * m[2],
+        ds[2] * m[1] + ds[3] * m[3],
+    ]
+}
+
 /// 2D polar decomposition of `F` (row-major 2x2): returns `(cos θ, sin θ)` of `R`.
 #[inline]
 pub fn polar_2d(f: &[f64; 4]) -> (f64, f64) {

@@ -17,7 +17,7 @@ use pcdc_compute::{
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
-use crate::kinematics::{polar_2d, polar_3d};
+use crate::kinematics::{deformation_gradient_2d, dm_inv_2d, polar_2d, polar_3d};
 use crate::model::{double_dot, ConstitutiveModel, Sym6};
 use crate::MechError;
 
@@ -105,6 +105,12 @@ impl Mechanics {
         &*self.models[self.material[e] as usize]
     }
 
+    /// Viscous coefficient `D_f C` of element `e` with `C = 2 L √(ρE)` (eq. 18-19), Pa·s.
+    fn viscous_coefficient(&self, e: usize) -> f64 {
+        let m = self.model_of(e);
+        m.damp_factor() * 2.0 * self.geo.mean_edge[e] * (m.density() * m.young()).sqrt()
+    }
+
     fn element_dt(&self, e: usize, damped: bool) -> f64 {
         let m = self.model_of(e);
         let c = (m.wave_modulus() / m.density()).sqrt();
@@ -115,8 +121,7 @@ impl Mechanics {
         // Viscous stress D_f C ε̇ is stiffness-proportional damping β = D_f C / M,
         // ξ(ω) = β ω / 2 at the element's highest frequency ω = 2c/h; central difference
         // is stable for dt ≤ (2/ω)(√(1+ξ²) − ξ).
-        let cdamp = 2.0 * self.geo.mean_edge[e] * (m.density() * m.young()).sqrt();
-        let beta = m.damp_factor() * cdamp / m.wave_modulus();
+        let beta = self.viscous_coefficient(e) / m.wave_modulus();
         let omega = 2.0 * c / h;
         let xi = 0.5 * beta * omega;
         (2.0 / omega) * ((1.0 + xi * xi).sqrt() - xi)
@@ -154,10 +159,7 @@ fn geometry<D: Dim>(mesh: &Mesh<D>) -> ElementGeometry {
         g.mean_edge[e] = sum / cnt;
         if d == 2 {
             g.height[e] = 2.0 * vol / longest;
-            let (a, b, c, dd) = (x[2] - x[0], x[4] - x[0], x[3] - x[1], x[5] - x[1]);
-            // D_m = [[a, b], [c, dd]] (columns are edges 1-0 and 2-0).
-            let det = a * dd - b * c;
-            g.dm_inv[e * 4..e * 4 + 4].copy_from_slice(&[dd / det, -b / det, -c / det, a / det]);
+            g.dm_inv[e * 4..e * 4 + 4].copy_from_slice(&dm_inv_2d(&x[..6]));
         } else {
             let mut max_face = 0.0f64;
             let mut n = [0.0; 3];
@@ -218,15 +220,9 @@ impl Mechanics {
         let c = &inp.conn[3 * e..3 * e + 3];
         let (n0, n1, n2) = (c[0] as usize * 2, c[1] as usize * 2, c[2] as usize * 2);
         let p = |n: usize, k: usize| inp.x0[n + k] + inp.u[n + k];
-        let (x0, y0) = (p(n0, 0), p(n0, 1));
-        let ds = [p(n1, 0) - x0, p(n2, 0) - x0, p(n1, 1) - y0, p(n2, 1) - y0];
+        let x = [p(n0, 0), p(n0, 1), p(n1, 0), p(n1, 1), p(n2, 0), p(n2, 1)];
         let m = &self.geo.dm_inv[4 * e..4 * e + 4];
-        let f = [
-            ds[0] * m[0] + ds[1] * m[2],
-            ds[0] * m[1] + ds[1] * m[3],
-            ds[2] * m[0] + ds[3] * m[2],
-            ds[2] * m[1] + ds[3] * m[3],
-        ];
+        let f = deformation_gradient_2d(&x, m);
         let (co, si) = polar_2d(&f);
         // U = Rᵀ F
         let u00 = co * f[0] + si * f[2];
@@ -269,10 +265,7 @@ impl Mechanics {
             let r10 = -si * fd[0] + co * fd[2];
             let r11 = -si * fd[1] + co * fd[3];
             // eq. 17-19: σ_v = D_f C ε̇ with C = 2 L √(ρE)
-            let cv = model.damp_factor()
-                * 2.0
-                * self.geo.mean_edge[e]
-                * (model.density() * model.young()).sqrt();
+            let cv = self.viscous_coefficient(e);
             sxx += cv * r00;
             syy += cv * r11;
             sxy += cv * 0.5 * (r01 + r10);
@@ -366,10 +359,7 @@ impl Mechanics {
             }
             let fd = crate::kinematics::mul3(&dv, &mm);
             let rd = crate::kinematics::mul3_tn(&r, &fd);
-            let cv = model.damp_factor()
-                * 2.0
-                * self.geo.mean_edge[e]
-                * (model.density() * model.young()).sqrt();
+            let cv = self.viscous_coefficient(e);
             sig[0] += cv * rd[0];
             sig[1] += cv * rd[4];
             sig[2] += cv * rd[8];

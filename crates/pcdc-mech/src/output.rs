@@ -6,7 +6,7 @@ use pcdc_mesh::vtu::{DataArray, PvdSeries};
 use pcdc_mesh::Dim;
 
 use crate::actions::DISPLACEMENT_RESET;
-use crate::kinematics::{mul3, mul3_tn, polar_2d};
+use crate::kinematics::{deformation_gradient_2d, dm_inv_2d, mul3, mul3_tn, polar_2d};
 use crate::MechError;
 
 /// Element Cauchy stress in the global frame (Pa, tension positive), stride NSYM
@@ -21,23 +21,11 @@ pub fn global_stress<D: Dim>(sim: &Simulation<D, CpuBackend>) -> Result<Vec<f64>
         let mut xr = [0.0; 6];
         for e in 0..mesh.n_elements() {
             mesh.element_coords(e, &mut xr);
-            let c = mesh.element(e);
-            let p = |a: usize, k: usize| x[c[a] as usize * 2 + k];
-            let ds = [
-                p(1, 0) - p(0, 0),
-                p(2, 0) - p(0, 0),
-                p(1, 1) - p(0, 1),
-                p(2, 1) - p(0, 1),
-            ];
-            let dm = [xr[2] - xr[0], xr[4] - xr[0], xr[3] - xr[1], xr[5] - xr[1]];
-            let det = dm[0] * dm[3] - dm[1] * dm[2];
-            let mi = [dm[3] / det, -dm[1] / det, -dm[2] / det, dm[0] / det];
-            let f = [
-                ds[0] * mi[0] + ds[1] * mi[2],
-                ds[0] * mi[1] + ds[1] * mi[3],
-                ds[2] * mi[0] + ds[3] * mi[2],
-                ds[2] * mi[1] + ds[3] * mi[3],
-            ];
+            let mut xc = [0.0; 6];
+            for (a, &n) in mesh.element(e).iter().enumerate() {
+                xc[2 * a..2 * a + 2].copy_from_slice(&x[n as usize * 2..n as usize * 2 + 2]);
+            }
+            let f = deformation_gradient_2d(&xc, &dm_inv_2d(&xr));
             let (co, si) = polar_2d(&f);
             let (a, b, cxy) = (s[3 * e], s[3 * e + 1], s[3 * e + 2]);
             out[3 * e] = co * co * a - 2.0 * co * si * cxy + si * si * b;
