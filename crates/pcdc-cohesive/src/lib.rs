@@ -1,0 +1,24 @@
+//! # pcdc-cohesive
+//!
+//! Fracture for the pcdc-rs FDEM SDK (manual 7.4): joint constitutive models behind the
+//! [`JointModel`] plugin trait, starting with the intrinsic cohesive zone model
+//! [`IntrinsicCzm`] (eq. 63-73: penalties, peak opening and slip, damage D, softening
+//! f(D) with A = 0.63, B = 1.8, C = 6.0, Mohr-Coulomb shear strength, unloading along
+//! the secant, softening lengths from G_f1 and G_f2), and node splitting
+//! ([`split_nodes`]) that gives the elements of FDEM regions their own nodes and puts a
+//! face-joint on every interior face.
+
+#![warn(missing_docs)]
+// Index loops mirror the tensor notation of the manual's equations.
+#![allow(clippy::needless_range_loop)]
+
+mod error;
+mod model;
+mod split;
+
+pub use error::CohesiveError;
+pub use model::{
+    czm_state, softening, softening_integral, FailureMode, IntrinsicCzm, JointModel, Traction,
+    SOFTENING_A, SOFTENING_B, SOFTENING_C,
+};
+pub use split::{split_nodes, Joints, SplitMesh};

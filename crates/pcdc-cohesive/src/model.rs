@@ -1,0 +1,470 @@
+//! Joint constitutive models: the `JointModel` plugin trait and the intrinsic cohesive
+//! zone model of manual 7.4.1 (eq. 63-73).
+//!
+//! Sign conventions: the opening `o` (m) is positive when the two joint faces separate
+//! and negative when they overlap; the normal traction `σ` (Pa) is positive when it
+//! pulls the faces together (cohesion) and negative when it pushes them apart
+//! (overlap); the shear traction opposes the slip.
+
+use serde::{Deserialize, Serialize};
+
+use crate::CohesiveError;
+
+/// Coefficients of the softening function f(D) (eq. 69), as fixed by the manual.
+pub const SOFTENING_A: f64 = 0.63;
+/// See [`SOFTENING_A`].
+pub const SOFTENING_B: f64 = 1.8;
+/// See [`SOFTENING_A`].
+pub const SOFTENING_C: f64 = 6.0;
+
+/// Softening function f(D) of eq. 69: f(0) = 1, f(1) = 0, decreasing.
+pub fn softening(d: f64) -> f64 {
+    let (a, b, c) = (SOFTENING_A, SOFTENING_B, SOFTENING_C);
+    if d <= 0.0 {
+        return 1.0;
+    }
+    if d >= 1.0 {
+        return 0.0;
+    }
+    let z = (a + b - 1.0) / (a + b) * (d * (a + c * b) / ((a + b) * (1.0 - a - b))).exp();
+    (1.0 - z) * (a * (1.0 - d) + b * (1.0 - d).powf(c))
+}
+
+/// ∫₀¹ f(D) dD (composite Simpson, 2000 intervals): the softening work per unit
+/// strength and softening length.
+pub fn softening_integral() -> f64 {
+    let n = 2000;
+    let h = 1.0 / n as f64;
+    let mut sum = softening(0.0) + softening(1.0);
+    for i in 1..n {
+        sum += if i % 2 == 1 { 4.0 } else { 2.0 } * softening(i as f64 * h);
+    }
+    sum * h / 3.0
+}
+
+/// How a joint failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum FailureMode {
+    /// Not broken.
+    Intact,
+    /// Opening (mode I).
+    Tensile,
+    /// Sliding (mode II, with III merged in 3D).
+    Shear,
+    /// Mixed I-II.
+    Mixed,
+}
+
+impl FailureMode {
+    /// Encoding stored in a joint's state.
+    pub fn code(self) -> f64 {
+        match self {
+            FailureMode::Intact => 0.0,
+            FailureMode::Tensile => 1.0,
+            FailureMode::Shear => 2.0,
+            FailureMode::Mixed => 3.0,
+        }
+    }
+
+    /// Decodes [`FailureMode::code`].
+    pub fn from_code(c: f64) -> Self {
+        match c as i32 {
+            1 => FailureMode::Tensile,
+            2 => FailureMode::Shear,
+            3 => FailureMode::Mixed,
+            _ => FailureMode::Intact,
+        }
+    }
+}
+
+/// Tractions at a joint integration point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Traction {
+    /// Normal traction σ (Pa): positive pulls the faces together, negative pushes apart.
+    pub normal: f64,
+    /// Magnitude of the shear traction (Pa); it acts against the slip.
+    pub shear: f64,
+}
+
+/// A joint stress-displacement law evaluated at one integration point.
+pub trait JointModel: Send + Sync + std::fmt::Debug {
+    /// Model name.
+    fn name(&self) -> &str;
+    /// History variables per integration point.
+    fn n_state(&self) -> usize;
+    /// Initial history variables.
+    fn init_state(&self, state: &mut [f64]) {
+        state.fill(0.0);
+    }
+    /// Tractions for opening `o` (m) and slip magnitude `slip` (m, ≥ 0) at a joint of
+    /// characteristic length `h` (m); updates the history in `state`.
+    fn traction(&self, o: f64, slip: f64, h: f64, state: &mut [f64]) -> Traction;
+    /// Largest penalty stiffness per unit area (Pa/m) at characteristic length `h`,
+    /// for the stable time step.
+    fn max_stiffness(&self, h: f64) -> f64;
+    /// Whether the state says the joint is fully broken.
+    fn is_broken(&self, state: &[f64]) -> bool;
+}
+
+/// Parameters of the intrinsic cohesive zone model (manual table 9, keyword
+/// `classic-intrinsic-cohesive-interface`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IntrinsicCzm {
+    /// Friction angle φ (degrees).
+    pub friction_deg: f64,
+    /// Cohesion c (Pa).
+    pub cohesion: f64,
+    /// Tensile strength T_s (Pa).
+    pub tensile_strength: f64,
+    /// Mode I fracture energy G_f1 (N/m).
+    pub gf1: f64,
+    /// Mode II fracture energy G_f2 (N/m).
+    pub gf2: f64,
+    /// Normal opening penalty P_open (Pa).
+    pub penalty_open: f64,
+    /// Shear penalty P_tan (Pa).
+    pub penalty_shear: f64,
+    /// Overlap penalty P_overlap (Pa).
+    pub penalty_overlap: f64,
+    /// ∫₀¹ f(D) dD, cached.
+    #[serde(skip, default = "softening_integral")]
+    softening_work: f64,
+}
+
+/// State layout of [`IntrinsicCzm`]: damage D, largest opening, largest slip, failure mode.
+pub mod czm_state {
+    /// Damage D (eq. 68), never decreasing.
+    pub const DAMAGE: usize = 0;
+    /// Largest opening reached o_u (m).
+    pub const MAX_OPENING: usize = 1;
+    /// Largest slip reached s_u (m).
+    pub const MAX_SLIP: usize = 2;
+    /// [`crate::FailureMode::code`].
+    pub const MODE: usize = 3;
+    /// Number of state variables.
+    pub const LEN: usize = 4;
+}
+
+impl IntrinsicCzm {
+    /// The model with all parameters checked (strengths, energies and penalties
+    /// positive and finite; 0 ≤ φ < 90°).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        friction_deg: f64,
+        cohesion: f64,
+        tensile_strength: f64,
+        gf1: f64,
+        gf2: f64,
+        penalty_open: f64,
+        penalty_shear: f64,
+        penalty_overlap: f64,
+    ) -> Result<Self, CohesiveError> {
+        let positive: [(&'static str, f64); 7] = [
+            ("cohesion c", cohesion),
+            ("tensile strength Ts", tensile_strength),
+            ("Gf1", gf1),
+            ("Gf2", gf2),
+            ("normal penalty P_open", penalty_open),
+            ("shear penalty P_tan", penalty_shear),
+            ("overlap penalty P_overlap", penalty_overlap),
+        ];
+        for (name, value) in positive {
+            if !(value > 0.0 && value.is_finite()) {
+                return Err(CohesiveError::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be positive and finite",
+                });
+            }
+        }
+        if !(0.0..90.0).contains(&friction_deg) {
+            return Err(CohesiveError::InvalidParameter {
+                name: "friction angle",
+                value: friction_deg,
+                reason: "must lie in [0, 90) degrees",
+            });
+        }
+        Ok(IntrinsicCzm {
+            friction_deg,
+            cohesion,
+            tensile_strength,
+            gf1,
+            gf2,
+            penalty_open,
+            penalty_shear,
+            penalty_overlap,
+            softening_work: softening_integral(),
+        })
+    }
+
+    /// Peak opening o_p = 2 h T_s / P_open (eq. 65), m.
+    pub fn peak_opening(&self, h: f64) -> f64 {
+        2.0 * h * self.tensile_strength / self.penalty_open
+    }
+
+    /// Peak slip s_p = 2 h c / P_tan (eq. 66), m.
+    pub fn peak_slip(&self, h: f64) -> f64 {
+        2.0 * h * self.cohesion / self.penalty_shear
+    }
+
+    /// Characteristic overlap o_overlap = 2 h T_s / P_overlap (eq. 67), m.
+    pub fn overlap_length(&self, h: f64) -> f64 {
+        2.0 * h * self.tensile_strength / self.penalty_overlap
+    }
+
+    /// Softening opening o_t (m): the opening beyond o_p at which D reaches 1, chosen so
+    /// that the softening branch dissipates G_f1 (eq. 70): G_f1 = T_s o_t ∫₀¹ f.
+    pub fn softening_opening(&self) -> f64 {
+        self.gf1 / (self.tensile_strength * self.softening_work)
+    }
+
+    /// Softening slip s_t (m): the cohesive part of the softening branch dissipates
+    /// G_f2 (eq. 71, the residual friction work W_res comes on top).
+    pub fn softening_slip(&self) -> f64 {
+        self.gf2 / (self.cohesion * self.softening_work)
+    }
+}
+
+/// `[2x − x²]` for x in [0, 1]: the pre-peak hardening curve of eq. 63-64.
+#[inline]
+fn rising(x: f64) -> f64 {
+    x * (2.0 - x)
+}
+
+impl JointModel for IntrinsicCzm {
+    fn name(&self) -> &str {
+        "classic-intrinsic-cohesive-interface"
+    }
+
+    fn n_state(&self) -> usize {
+        czm_state::LEN
+    }
+
+    fn traction(&self, o: f64, slip: f64, h: f64, state: &mut [f64]) -> Traction {
+        use czm_state::*;
+        let (op, sp, ov) = (
+            self.peak_opening(h),
+            self.peak_slip(h),
+            self.overlap_length(h),
+        );
+        let (ot, st) = (self.softening_opening(), self.softening_slip());
+        let slip = slip.abs();
+        // Damage (eq. 68), irreversible. Before the peak in both modes nothing is
+        // evaluated beyond comparisons: an undamaged joint pays no exp/pow.
+        let mut d = state[DAMAGE];
+        if o > op || slip > sp {
+            let dn = ((o - op) / ot).max(0.0);
+            let ds = ((slip - sp) / st).max(0.0);
+            let trial = (dn * dn + ds * ds).sqrt().min(1.0);
+            if trial > d {
+                d = trial;
+                if d >= 1.0 && state[MODE] == 0.0 {
+                    let mode = if ds * ds < 0.1 * dn * dn {
+                        FailureMode::Tensile
+                    } else if dn * dn < 0.1 * ds * ds {
+                        FailureMode::Shear
+                    } else {
+                        FailureMode::Mixed
+                    };
+                    state[MODE] = mode.code();
+                }
+                state[DAMAGE] = d;
+            }
+        }
+        let f = if d > 0.0 { softening(d) } else { 1.0 };
+        let ou = state[MAX_OPENING].max(o);
+        let su = state[MAX_SLIP].max(slip);
+        state[MAX_OPENING] = ou;
+        state[MAX_SLIP] = su;
+        // Normal traction (eq. 63, unloading eq. 72).
+        let ts = self.tensile_strength;
+        let normal = if o < 0.0 {
+            2.0 * o / ov * ts
+        } else if ou > op && o < ou {
+            f * ts * o / ou
+        } else if o <= op {
+            rising(o / op) * f * ts
+        } else {
+            f * ts
+        };
+        // Shear strength: Mohr-Coulomb with the softened cohesion (eq. 64).
+        let tan_phi = self.friction_deg.to_radians().tan();
+        let strength = (-normal * tan_phi + f * self.cohesion).max(0.0);
+        let shear = if su > sp && slip < su {
+            strength * slip / su
+        } else if slip <= sp {
+            rising(slip / sp) * strength
+        } else {
+            strength
+        };
+        Traction { normal, shear }
+    }
+
+    fn max_stiffness(&self, h: f64) -> f64 {
+        // Initial slopes: 2 T_s / o_p = P_open / h, 2 T_s / o_overlap = P_overlap / h.
+        self.penalty_open
+            .max(self.penalty_shear)
+            .max(self.penalty_overlap)
+            / h
+    }
+
+    fn is_broken(&self, state: &[f64]) -> bool {
+        state[czm_state::DAMAGE] >= 1.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const H: f64 = 0.002;
+
+    fn czm() -> IntrinsicCzm {
+        // UCS quick-start joints (VALIDATION.md scene 8) with E = 30 GPa.
+        IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, 300e9, 300e9, 3000e9).unwrap()
+    }
+
+    /// Trapezoidal work ∫ σ do along a monotonic path from `a` to `b` in `n` steps.
+    fn work_normal(m: &IntrinsicCzm, state: &mut [f64], a: f64, b: f64, n: usize) -> f64 {
+        let mut w = 0.0;
+        let mut prev = m.traction(a, 0.0, H, state).normal;
+        for i in 1..=n {
+            let o = a + (b - a) * i as f64 / n as f64;
+            let t = m.traction(o, 0.0, H, state).normal;
+            w += 0.5 * (prev + t) * (b - a) / n as f64;
+            prev = t;
+        }
+        w
+    }
+
+    #[test]
+    fn softening_function_ends() {
+        assert!((softening(0.0) - 1.0).abs() < 1e-15);
+        assert_eq!(softening(1.0), 0.0);
+        let mut prev = 1.0;
+        for i in 1..=100 {
+            let f = softening(i as f64 / 100.0);
+            assert!(f <= prev + 1e-15, "f must not increase");
+            prev = f;
+        }
+        let i = softening_integral();
+        assert!(i > 0.0 && i < 1.0, "{i}");
+    }
+
+    #[test]
+    fn mode_one_dissipates_gf1() {
+        let m = czm();
+        let mut s = [0.0; 4];
+        let op = m.peak_opening(H);
+        let _ = work_normal(&m, &mut s, 0.0, op, 1000);
+        let soft = work_normal(&m, &mut s, op, op + 1.2 * m.softening_opening(), 200_000);
+        assert!(
+            (soft - m.gf1).abs() < 0.02 * m.gf1,
+            "softening work {soft} vs Gf1 {}",
+            m.gf1
+        );
+        assert!(m.is_broken(&s));
+        assert_eq!(
+            FailureMode::from_code(s[czm_state::MODE]),
+            FailureMode::Tensile
+        );
+    }
+
+    #[test]
+    fn mode_two_dissipates_gf2_plus_friction() {
+        let m = czm();
+        let sigma_n = -1e6; // compression held by an overlap
+        let o = sigma_n / (2.0 * m.tensile_strength) * m.overlap_length(H);
+        let mut s = [0.0; 4];
+        let (sp, st) = (m.peak_slip(H), m.softening_slip());
+        let n = 200_000;
+        let (mut w, mut prev) = (0.0, m.traction(o, sp, H, &mut s).shear);
+        for i in 1..=n {
+            let slip = sp + 1.2 * st * i as f64 / n as f64;
+            let t = m.traction(o, slip, H, &mut s).shear;
+            w += 0.5 * (prev + t) * 1.2 * st / n as f64;
+            prev = t;
+        }
+        let friction = -sigma_n * m.friction_deg.to_radians().tan() * 1.2 * st;
+        let expect = m.gf2 + friction;
+        assert!(
+            (w - expect).abs() < 0.02 * expect,
+            "work {w} vs Gf2 + friction {expect}"
+        );
+        assert_eq!(
+            FailureMode::from_code(s[czm_state::MODE]),
+            FailureMode::Shear
+        );
+    }
+
+    #[test]
+    fn traction_continuous_at_the_peak() {
+        let m = czm();
+        let op = m.peak_opening(H);
+        let below = m.traction(op * (1.0 - 1e-9), 0.0, H, &mut [0.0; 4]).normal;
+        let above = m.traction(op * (1.0 + 1e-9), 0.0, H, &mut [0.0; 4]).normal;
+        assert!((below - m.tensile_strength).abs() < 1e-6 * m.tensile_strength);
+        assert!((above - m.tensile_strength).abs() < 1e-6 * m.tensile_strength);
+        let sp = m.peak_slip(H);
+        let b = m.traction(0.0, sp * (1.0 - 1e-9), H, &mut [0.0; 4]).shear;
+        let a = m.traction(0.0, sp * (1.0 + 1e-9), H, &mut [0.0; 4]).shear;
+        assert!((a - b).abs() < 1e-6 * m.cohesion && (a - m.cohesion).abs() < 1e-6 * m.cohesion);
+    }
+
+    #[test]
+    fn invalid_parameters() {
+        assert!(IntrinsicCzm::new(30.0, 10e6, -2e6, 0.5, 5.0, 3e11, 3e11, 3e12).is_err());
+        assert!(IntrinsicCzm::new(95.0, 10e6, 2e6, 0.5, 5.0, 3e11, 3e11, 3e12).is_err());
+        assert!(IntrinsicCzm::new(30.0, 10e6, 2e6, 0.0, 5.0, 3e11, 3e11, 3e12).is_err());
+        assert!(IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, f64::NAN, 3e11, 3e12).is_err());
+    }
+
+    proptest! {
+        /// D never decreases along an arbitrary path, and a broken joint carries no
+        /// tension.
+        #[test]
+        fn damage_monotone_and_no_tension_after_break(path in proptest::collection::vec((-1.0f64..4.0, 0.0f64..4.0), 1..60)) {
+            let m = czm();
+            let (op, sp) = (m.peak_opening(H), m.peak_slip(H));
+            let scale_o = op + m.softening_opening();
+            let scale_s = sp + m.softening_slip();
+            let mut s = [0.0; 4];
+            let mut d_prev = 0.0;
+            for (a, b) in path {
+                let t = m.traction(a * scale_o, b * scale_s, H, &mut s);
+                prop_assert!(s[czm_state::DAMAGE] >= d_prev);
+                d_prev = s[czm_state::DAMAGE];
+                prop_assert!(t.shear >= 0.0 && t.normal.is_finite());
+                if m.is_broken(&s) {
+                    prop_assert!(t.normal <= 0.0, "tension {} after break", t.normal);
+                }
+            }
+        }
+
+        /// The response depends on |slip| only: +s and -s give the same tractions.
+        #[test]
+        fn symmetric_in_slip(o in -1.0f64..3.0, sl in 0.0f64..3.0) {
+            let m = czm();
+            let (o, sl) = (o * m.peak_opening(H), sl * m.peak_slip(H));
+            let a = m.traction(o, sl, H, &mut [0.0; 4]);
+            let b = m.traction(o, -sl, H, &mut [0.0; 4]);
+            prop_assert_eq!(a, b);
+        }
+
+        /// After softening to o_u, unloading follows the secant σ(o_u) o / o_u.
+        #[test]
+        fn unloading_along_the_secant(k in 0.05f64..0.9, back in 0.0f64..1.0) {
+            let m = czm();
+            let mut s = [0.0; 4];
+            let ou = m.peak_opening(H) + k * m.softening_opening();
+            let at_u = m.traction(ou, 0.0, H, &mut s).normal;
+            let o = back * ou;
+            let t = m.traction(o, 0.0, H, &mut s).normal;
+            prop_assert!((t - at_u * o / ou).abs() <= 1e-9 * m.tensile_strength);
+            // Reloading to o_u gives back the same traction (no further damage).
+            let again = m.traction(ou, 0.0, H, &mut s).normal;
+            prop_assert!((again - at_u).abs() <= 1e-9 * m.tensile_strength);
+        }
+    }
+}
