@@ -13,10 +13,12 @@
 #![allow(clippy::needless_range_loop)]
 
 mod error;
+mod joints;
 mod model;
 mod split;
 
 pub use error::CohesiveError;
+pub use joints::{CohesiveJoints, BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE};
 pub use model::{
     czm_state, softening, softening_integral, FailureMode, IntrinsicCzm, JointModel, Traction,
     SOFTENING_A, SOFTENING_B, SOFTENING_C,

@@ -31,6 +31,8 @@ pub enum Location {
     Element,
     /// One value set per face.
     Face,
+    /// One value set per entity of a physics-defined set of the given size (e.g. joints).
+    Entities(usize),
 }
 
 /// The declaration of a field by a physics.

@@ -34,6 +34,8 @@ pub struct StableStep {
 pub struct Kinematics<'a, D: Dim> {
     /// The mesh (reference configuration).
     pub mesh: &'a Mesh<D>,
+    /// Physical lumped node mass (kg).
+    pub mass: &'a [f64],
     /// Node displacement (m), stride D.
     pub u: &'a [f64],
     /// Node velocity (m/s), stride D (at the half step before the update in progress).

@@ -172,6 +172,7 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
                     crate::Location::Node => n_nodes,
                     crate::Location::Element => mesh.n_elements(),
                     crate::Location::Face => mesh.faces().len(),
+                    crate::Location::Entities(n) => n,
                 };
                 fields.declare(spec, count)?;
             }
@@ -333,6 +334,7 @@ impl<D: Dim> Simulation<D, CpuBackend> {
             let mut ctx = ForceContext {
                 kin: Kinematics {
                     mesh: &self.mesh,
+                    mass: &self.mass_phys,
                     u: kin_u,
                     v: kin_v,
                     time: self.state.time,
@@ -538,6 +540,7 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
     pub fn kinematics(&self) -> Kinematics<'_, D> {
         Kinematics {
             mesh: &self.mesh,
+            mass: &self.mass_phys,
             u: &self.state.u,
             v: &self.state.v,
             time: self.state.time,

@@ -148,6 +148,21 @@ impl Range {
         }
     }
 
+    /// Whether a free point `x` (length `D`, m) lies in the range, for entities that are
+    /// not nodes, elements or faces (e.g. joints). Group ranges cannot answer for a
+    /// point and are an error.
+    pub fn contains_point(&self, x: &[f64]) -> Result<bool, crate::MeshError> {
+        self.validate()?;
+        let mut names = Vec::new();
+        self.group_names(&mut names);
+        if let Some(g) = names.first() {
+            return Err(crate::MeshError::InvalidRange(format!(
+                "group '{g}' cannot select a free point; use a geometric range"
+            )));
+        }
+        Ok(self.contains(x, &|_| false))
+    }
+
     /// Whether the point `x` (length `D`) lies in the geometric part of the range.
     /// `in_group` answers group membership for the entity being tested.
     pub(crate) fn contains(&self, x: &[f64], in_group: &dyn Fn(&str) -> bool) -> bool {

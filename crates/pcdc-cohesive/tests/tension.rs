@@ -1,0 +1,116 @@
+//! A fully split bar pulled apart breaks when its mean stress reaches the tensile
+//! strength (2D and 3D), with results independent of the thread count.
+
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, JOINT_DAMAGE};
+use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_mech::{Boundary, LinearElastic, Mechanics};
+use pcdc_mesh::{builders, Dim, Mesh, Range};
+
+const E: f64 = 30e9;
+const TS: f64 = 2e6;
+
+fn czm() -> IntrinsicCzm {
+    IntrinsicCzm::new(30.0, 10e6, TS, 0.5, 5.0, 10.0 * E, 10.0 * E, 100.0 * E).unwrap()
+}
+
+/// Pulls the `top` group up at `v` with `bottom` held in the pull direction; returns the
+/// peak mean stress (Pa) on the bottom section and the number of broken joints.
+fn pull<D: Dim>(
+    mesh: Mesh<D>,
+    bottom: &str,
+    top: &str,
+    area: f64,
+    threads: usize,
+) -> (f64, usize, Vec<f64>) {
+    let split = split_nodes(&mesh, &Range::All).unwrap();
+    let axis = D::D - 1;
+    let mut up = [None, None, None];
+    up[axis] = Some(0.02.into());
+    let mut hold = [None, None, None];
+    hold[axis] = Some(0.0.into());
+    let rock = LinearElastic::new(E, 0.25, 2600.0)
+        .unwrap()
+        .with_damping(0.3)
+        .unwrap();
+    let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(threads).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(CohesiveJoints::new(split.joints.clone()).model(Range::All, czm()))
+        .physics(
+            Boundary::new()
+                .velocity(Range::group(bottom), hold)
+                .velocity(Range::group(top), up),
+        )
+        .build()
+        .unwrap();
+    let bottom_nodes = sim.mesh().select_nodes(&Range::group(bottom)).unwrap();
+    let mut peak = 0.0f64;
+    let mut history = Vec::new();
+    for _ in 0..200_000 {
+        sim.step().unwrap();
+        let f: f64 = bottom_nodes
+            .iter()
+            .map(|&n| sim.node_force()[n as usize * D::D + axis])
+            .sum();
+        // Tension pulls the held bottom nodes up: the gathered force there is the
+        // reaction's opposite, positive in tension.
+        let stress = f / area;
+        peak = peak.max(stress);
+        history.push(stress);
+        if peak > 0.0
+            && stress < 0.05 * peak
+            && sim.field(JOINT_DAMAGE).unwrap().iter().any(|&d| d >= 1.0)
+        {
+            break;
+        }
+    }
+    let broken = sim
+        .field(JOINT_DAMAGE)
+        .unwrap()
+        .iter()
+        .filter(|&&d| d >= 1.0)
+        .count();
+    (peak, broken, history)
+}
+
+#[test]
+fn bar_2d_breaks_at_the_tensile_strength() {
+    let mesh = builders::rectangle(0.0, 0.0, 0.02, 0.04, 0.005).unwrap();
+    let (peak, broken, _) = pull(mesh, "bottom", "top", 0.02, 2);
+    eprintln!("2D peak {:.3} MPa, broken joints {broken}", peak / 1e6);
+    assert!(broken > 0);
+    assert!((peak - TS).abs() < 0.10 * TS, "peak {peak} vs Ts {TS}");
+}
+
+#[test]
+fn bar_3d_breaks_at_the_tensile_strength() {
+    let mesh = builders::cuboid([0.0; 3], [0.01, 0.01, 0.02], 0.005).unwrap();
+    let (peak, broken, _) = pull(mesh, "zmin", "zmax", 1e-4, 2);
+    eprintln!("3D peak {:.3} MPa, broken joints {broken}", peak / 1e6);
+    assert!(broken > 0);
+    assert!((peak - TS).abs() < 0.10 * TS, "peak {peak} vs Ts {TS}");
+}
+
+#[test]
+fn undamped_joints_limit_the_time_step() {
+    let mesh = builders::rectangle(0.0, 0.0, 0.02, 0.04, 0.005).unwrap();
+    let split = split_nodes(&mesh, &Range::All).unwrap();
+    let sim = Simulation::builder(split.mesh, CpuBackend::new(1).unwrap())
+        .physics(
+            Mechanics::new().material(Range::All, LinearElastic::new(E, 0.25, 2600.0).unwrap()),
+        )
+        .physics(CohesiveJoints::new(split.joints).model(Range::All, czm()))
+        .build()
+        .unwrap();
+    let limit = sim.time_step_limit().unwrap();
+    assert!(limit.entity.starts_with("joint "), "{limit:?}");
+    assert_eq!(limit.physics, "cohesive joints");
+}
+
+#[test]
+fn joint_forces_identical_for_any_thread_count() {
+    let mesh = builders::rectangle(0.0, 0.0, 0.02, 0.04, 0.005).unwrap();
+    let (_, _, a) = pull(mesh.clone(), "bottom", "top", 0.02, 1);
+    let (_, _, b) = pull(mesh, "bottom", "top", 0.02, 2);
+    assert_eq!(a.len(), b.len());
+    assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
+}
