@@ -35,6 +35,7 @@
 // Index loops mirror the tensor notation of the manual's equations.
 #![allow(clippy::needless_range_loop)]
 
+pub use pcdc_cohesive as cohesive;
 pub use pcdc_compute as compute;
 pub use pcdc_mech as mech;
 pub use pcdc_mesh as mesh;

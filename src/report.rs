@@ -117,6 +117,9 @@ pub enum SceneError {
     /// Mechanics error.
     #[error(transparent)]
     Mech(#[from] pcdc_mech::MechError),
+    /// Cohesive error.
+    #[error(transparent)]
+    Cohesive(#[from] pcdc_cohesive::CohesiveError),
     /// Plot error.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),

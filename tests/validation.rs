@@ -50,3 +50,37 @@ fn vibration_energy_drift_below_half_percent_2d_and_3d() {
         assert!(min_se < 0.2, "strain energy never released: {min_se}");
     }
 }
+
+#[test]
+fn direct_tension_peak_at_ts_and_crack_across_the_neck() {
+    use pcdc::scenes::direct_tension as dt;
+    let out = dt::run(&dt::Params::reduced()).unwrap();
+    eprintln!("direct tension: peak {:.3} MPa ({:+.2} %), elements {}, joints {}, broken {}, steps {}, wall {:.2}s", out.peak / 1e6, 100.0 * out.deviation, out.elements, out.joints, out.broken.len(), out.steps, out.wall_s);
+    assert!(
+        out.band_metric() <= 1.0,
+        "peak {} vs Ts {}",
+        out.peak,
+        dt::TS
+    );
+    assert!(!out.broken.is_empty());
+    // The broken joints lie in the neck band and cut across it.
+    for b in &out.broken {
+        assert!(b[1].abs() <= 0.5 * dt::NECK, "broken joint at y = {}", b[1]);
+    }
+    let xmin = out
+        .broken
+        .iter()
+        .map(|b| b[0])
+        .fold(f64::INFINITY, f64::min);
+    let xmax = out
+        .broken
+        .iter()
+        .map(|b| b[0])
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        xmax - xmin > 0.6 * dt::NECK,
+        "crack spans {} of the {} m neck",
+        xmax - xmin,
+        dt::NECK
+    );
+}
