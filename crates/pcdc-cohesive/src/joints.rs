@@ -76,6 +76,8 @@ fn gauss_rule(d: usize, points: usize) -> Vec<([f64; 3], f64)> {
 pub struct CohesiveJoints {
     joints: Joints,
     assignments: Vec<(Range, Arc<dyn JointModel>)>,
+    /// Assignments by joint index: (index into `assignments`, joints).
+    explicit: Vec<(usize, Vec<u32>)>,
     gauss_3d: usize,
     models: Vec<Arc<dyn JointModel>>,
     model_of: Vec<u16>,
@@ -92,6 +94,7 @@ impl CohesiveJoints {
         CohesiveJoints {
             joints,
             assignments: Vec::new(),
+            explicit: Vec::new(),
             gauss_3d: 3,
             models: Vec::new(),
             model_of: Vec::new(),
@@ -106,6 +109,15 @@ impl CohesiveJoints {
     /// assignments override earlier ones.
     pub fn model(mut self, range: Range, model: impl JointModel + 'static) -> Self {
         self.assignments.push((range, Arc::new(model)));
+        self
+    }
+
+    /// Assigns a joint model to the listed joints (e.g. from
+    /// [`crate::joints_on_fractures`]); later assignments override earlier ones.
+    pub fn model_for(mut self, joints: Vec<u32>, model: impl JointModel + 'static) -> Self {
+        self.explicit.push((self.assignments.len(), joints));
+        self.assignments
+            .push((Range::custom(|_| false), Arc::new(model)));
         self
     }
 
@@ -164,18 +176,12 @@ impl CohesiveJoints {
             for c in 0..d {
                 s[c] = delta[c] - o * n[c];
             }
-            let slip = (0..d).map(|c| s[c] * s[c]).sum::<f64>().sqrt();
             let st = &mut state[g * ns..(g + 1) * ns];
-            let t = model.traction(o, slip, self.h[j], st);
-            damage = damage.max(st[0]);
+            let t = model.traction(o, &s[..d], self.h[j], st);
+            damage = damage.max(model.damage(st));
             let mut tv = [0.0; 3];
             for c in 0..d {
-                tv[c] = t.normal * n[c]
-                    + if slip > 0.0 {
-                        t.shear * s[c] / slip
-                    } else {
-                        0.0
-                    };
+                tv[c] = t.normal * n[c] + t.shear[c];
             }
             for k in 0..npf {
                 let f = w * area * shape[k];
@@ -245,6 +251,13 @@ impl<D: Dim> Physics<D, CpuBackend> for CohesiveJoints {
                 "no joint model assigned: add CohesiveJoints::model".into()
             ));
         }
+        for (_, list) in self.explicit.iter_mut() {
+            list.sort_unstable();
+            list.dedup();
+            if let Some(&bad) = list.iter().find(|&&j| j as usize >= nj) {
+                return Err(err(format!("joint {bad} does not exist ({nj} joints)")));
+            }
+        }
         self.rule = gauss_rule(d, self.gauss_3d);
         self.n_state = self
             .assignments
@@ -265,7 +278,11 @@ impl<D: Dim> Physics<D, CpuBackend> for CohesiveJoints {
                 }
             }
             for (i, (range, _)) in self.assignments.iter().enumerate() {
-                let hit = range.contains_point(&mid).map_err(|e| err(e.to_string()))?;
+                let by_index = self.explicit.iter().find(|(k, _)| *k == i);
+                let hit = match by_index {
+                    Some((_, list)) => list.binary_search(&(j as u32)).is_ok(),
+                    None => range.contains_point(&mid).map_err(|e| err(e.to_string()))?,
+                };
                 if hit {
                     model_of[j] = i as u16;
                 }

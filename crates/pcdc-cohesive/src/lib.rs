@@ -13,14 +13,16 @@
 #![allow(clippy::needless_range_loop)]
 
 mod error;
+pub mod fractures;
 mod joints;
 mod model;
 mod split;
 
 pub use error::CohesiveError;
+pub use fractures::{joints_on_fractures, Distribution, Fracture, FractureNetwork};
 pub use joints::{CohesiveJoints, BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE};
 pub use model::{
-    czm_state, softening, softening_integral, FailureMode, IntrinsicCzm, JointModel, Traction,
-    SOFTENING_A, SOFTENING_B, SOFTENING_C,
+    czm_state, softening, softening_integral, FailureMode, IntrinsicCzm, JointModel,
+    MohrCoulombJoint, Traction, SOFTENING_A, SOFTENING_B, SOFTENING_C,
 };
 pub use split::{split_nodes, Joints, SplitMesh};

@@ -82,8 +82,17 @@ impl FailureMode {
 pub struct Traction {
     /// Normal traction σ (Pa): positive pulls the faces together, negative pushes apart.
     pub normal: f64,
-    /// Magnitude of the shear traction (Pa); it acts against the slip.
-    pub shear: f64,
+    /// Shear traction vector (Pa, global components, first `D` used) acting on side A;
+    /// side B receives the opposite. A resisting shear points along the slip of B
+    /// relative to A.
+    pub shear: [f64; 3],
+}
+
+impl Traction {
+    /// Magnitude of the shear traction (Pa).
+    pub fn shear_magnitude(&self) -> f64 {
+        self.shear.iter().map(|v| v * v).sum::<f64>().sqrt()
+    }
 }
 
 /// A joint stress-displacement law evaluated at one integration point.
@@ -96,14 +105,23 @@ pub trait JointModel: Send + Sync + std::fmt::Debug {
     fn init_state(&self, state: &mut [f64]) {
         state.fill(0.0);
     }
-    /// Tractions for opening `o` (m) and slip magnitude `slip` (m, ≥ 0) at a joint of
+    /// Tractions for opening `o` (m) and slip vector `slip` (m; the tangential gap of side
+    /// B relative to side A in global components, length `D` or less) at a joint of
     /// characteristic length `h` (m); updates the history in `state`.
-    fn traction(&self, o: f64, slip: f64, h: f64, state: &mut [f64]) -> Traction;
+    fn traction(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction;
     /// Largest penalty stiffness per unit area (Pa/m) at characteristic length `h`,
     /// for the stable time step.
     fn max_stiffness(&self, h: f64) -> f64;
     /// Whether the state says the joint is fully broken.
     fn is_broken(&self, state: &[f64]) -> bool;
+    /// Damage in [0, 1] for output (1 = broken, a discontinuity contact may act on).
+    fn damage(&self, state: &[f64]) -> f64 {
+        if self.is_broken(state) {
+            1.0
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Parameters of the intrinsic cohesive zone model (manual table 9, keyword
@@ -240,15 +258,15 @@ impl JointModel for IntrinsicCzm {
         czm_state::LEN
     }
 
-    fn traction(&self, o: f64, slip: f64, h: f64, state: &mut [f64]) -> Traction {
+    fn traction(&self, o: f64, slip_vec: &[f64], h: f64, state: &mut [f64]) -> Traction {
         use czm_state::*;
+        let slip = slip_vec.iter().map(|v| v * v).sum::<f64>().sqrt();
         let (op, sp, ov) = (
             self.peak_opening(h),
             self.peak_slip(h),
             self.overlap_length(h),
         );
         let (ot, st) = (self.softening_opening(), self.softening_slip());
-        let slip = slip.abs();
         // Damage (eq. 68), irreversible. Before the peak in both modes nothing is
         // evaluated beyond comparisons: an undamaged joint pays no exp/pow.
         let mut d = state[DAMAGE];
@@ -297,7 +315,13 @@ impl JointModel for IntrinsicCzm {
         } else {
             strength
         };
-        Traction { normal, shear }
+        let mut sv = [0.0; 3];
+        if slip > 0.0 {
+            for (k, v) in slip_vec.iter().enumerate() {
+                sv[k] = shear * v / slip;
+            }
+        }
+        Traction { normal, shear: sv }
     }
 
     fn max_stiffness(&self, h: f64) -> f64 {
@@ -310,6 +334,118 @@ impl JointModel for IntrinsicCzm {
 
     fn is_broken(&self, state: &[f64]) -> bool {
         state[czm_state::DAMAGE] >= 1.0
+    }
+
+    fn damage(&self, state: &[f64]) -> f64 {
+        state[czm_state::DAMAGE]
+    }
+}
+
+/// A pre-existing fracture (Mohr-Coulomb joint): no tensile strength, a normal penalty
+/// against overlap (σ = P_n o / h for o < 0, as the cohesive model's overlap branch),
+/// and elastic-perfectly plastic shear with the strength τ_max = c_r − σ tan φ (c_r the
+/// residual cohesion, often zero). Shear acts only while the faces touch. The state
+/// holds the plastic slip vector (global components), so reversed sliding unloads
+/// elastically; large rotations of a sliding joint are not followed by that vector.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MohrCoulombJoint {
+    /// Friction angle φ (degrees).
+    pub friction_deg: f64,
+    /// Residual cohesion c_r (Pa), ≥ 0.
+    pub cohesion: f64,
+    /// Normal (overlap) penalty P_n (Pa).
+    pub penalty_normal: f64,
+    /// Shear penalty P_t (Pa).
+    pub penalty_shear: f64,
+}
+
+impl MohrCoulombJoint {
+    /// The joint with its parameters checked.
+    pub fn new(
+        friction_deg: f64,
+        cohesion: f64,
+        penalty_normal: f64,
+        penalty_shear: f64,
+    ) -> Result<Self, CohesiveError> {
+        if !(0.0..90.0).contains(&friction_deg) {
+            return Err(CohesiveError::InvalidParameter {
+                name: "friction angle",
+                value: friction_deg,
+                reason: "must lie in [0, 90) degrees",
+            });
+        }
+        if !(cohesion >= 0.0 && cohesion.is_finite()) {
+            return Err(CohesiveError::InvalidParameter {
+                name: "residual cohesion",
+                value: cohesion,
+                reason: "must be non-negative and finite",
+            });
+        }
+        for (name, value) in [
+            ("normal penalty P_n", penalty_normal),
+            ("shear penalty P_t", penalty_shear),
+        ] {
+            if !(value > 0.0 && value.is_finite()) {
+                return Err(CohesiveError::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be positive and finite",
+                });
+            }
+        }
+        Ok(MohrCoulombJoint {
+            friction_deg,
+            cohesion,
+            penalty_normal,
+            penalty_shear,
+        })
+    }
+}
+
+impl JointModel for MohrCoulombJoint {
+    fn name(&self) -> &str {
+        "joint-mohr-coulomb"
+    }
+
+    fn n_state(&self) -> usize {
+        3
+    }
+
+    fn traction(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction {
+        let mut t = Traction::default();
+        if o >= 0.0 {
+            // Open: no traction; the elastic slip restarts from the current slip.
+            for (k, v) in slip.iter().enumerate() {
+                state[k] = *v;
+            }
+            return t;
+        }
+        t.normal = self.penalty_normal * o / h;
+        let strength = (self.cohesion - t.normal * self.friction_deg.to_radians().tan()).max(0.0);
+        let kt = self.penalty_shear / h;
+        let mut trial = [0.0; 3];
+        for (k, v) in slip.iter().enumerate() {
+            trial[k] = kt * (v - state[k]);
+        }
+        let mag = trial.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if mag > strength {
+            // Plastic sliding: return to the yield surface, move the plastic slip.
+            let scale = strength / mag;
+            for k in 0..slip.len() {
+                trial[k] *= scale;
+                state[k] = slip[k] - trial[k] / kt;
+            }
+        }
+        t.shear = trial;
+        t
+    }
+
+    fn max_stiffness(&self, h: f64) -> f64 {
+        self.penalty_normal.max(self.penalty_shear) / h
+    }
+
+    fn is_broken(&self, _state: &[f64]) -> bool {
+        true
     }
 }
 
@@ -328,10 +464,10 @@ mod tests {
     /// Trapezoidal work ∫ σ do along a monotonic path from `a` to `b` in `n` steps.
     fn work_normal(m: &IntrinsicCzm, state: &mut [f64], a: f64, b: f64, n: usize) -> f64 {
         let mut w = 0.0;
-        let mut prev = m.traction(a, 0.0, H, state).normal;
+        let mut prev = m.traction(a, &[0.0], H, state).normal;
         for i in 1..=n {
             let o = a + (b - a) * i as f64 / n as f64;
-            let t = m.traction(o, 0.0, H, state).normal;
+            let t = m.traction(o, &[0.0], H, state).normal;
             w += 0.5 * (prev + t) * (b - a) / n as f64;
             prev = t;
         }
@@ -379,10 +515,10 @@ mod tests {
         let mut s = [0.0; 4];
         let (sp, st) = (m.peak_slip(H), m.softening_slip());
         let n = 200_000;
-        let (mut w, mut prev) = (0.0, m.traction(o, sp, H, &mut s).shear);
+        let (mut w, mut prev) = (0.0, m.traction(o, &[sp], H, &mut s).shear_magnitude());
         for i in 1..=n {
             let slip = sp + 1.2 * st * i as f64 / n as f64;
-            let t = m.traction(o, slip, H, &mut s).shear;
+            let t = m.traction(o, &[slip], H, &mut s).shear_magnitude();
             w += 0.5 * (prev + t) * 1.2 * st / n as f64;
             prev = t;
         }
@@ -402,13 +538,21 @@ mod tests {
     fn traction_continuous_at_the_peak() {
         let m = czm();
         let op = m.peak_opening(H);
-        let below = m.traction(op * (1.0 - 1e-9), 0.0, H, &mut [0.0; 4]).normal;
-        let above = m.traction(op * (1.0 + 1e-9), 0.0, H, &mut [0.0; 4]).normal;
+        let below = m
+            .traction(op * (1.0 - 1e-9), &[0.0], H, &mut [0.0; 4])
+            .normal;
+        let above = m
+            .traction(op * (1.0 + 1e-9), &[0.0], H, &mut [0.0; 4])
+            .normal;
         assert!((below - m.tensile_strength).abs() < 1e-6 * m.tensile_strength);
         assert!((above - m.tensile_strength).abs() < 1e-6 * m.tensile_strength);
         let sp = m.peak_slip(H);
-        let b = m.traction(0.0, sp * (1.0 - 1e-9), H, &mut [0.0; 4]).shear;
-        let a = m.traction(0.0, sp * (1.0 + 1e-9), H, &mut [0.0; 4]).shear;
+        let b = m
+            .traction(0.0, &[sp * (1.0 - 1e-9)], H, &mut [0.0; 4])
+            .shear_magnitude();
+        let a = m
+            .traction(0.0, &[sp * (1.0 + 1e-9)], H, &mut [0.0; 4])
+            .shear_magnitude();
         assert!((a - b).abs() < 1e-6 * m.cohesion && (a - m.cohesion).abs() < 1e-6 * m.cohesion);
     }
 
@@ -420,7 +564,47 @@ mod tests {
         assert!(IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, f64::NAN, 3e11, 3e12).is_err());
     }
 
+    fn mc() -> MohrCoulombJoint {
+        MohrCoulombJoint::new(30.0, 0.0, 3e12, 3e11).unwrap()
+    }
+
+    #[test]
+    fn mohr_coulomb_joint_has_no_tension_and_slides_at_the_friction_limit() {
+        let m = mc();
+        let mut s = [0.0; 3];
+        assert_eq!(
+            m.traction(1e-6, &[1e-6, 0.0], H, &mut s),
+            Traction::default()
+        );
+        let o = -1e-9;
+        let sigma = m.penalty_normal * o / H;
+        let t = m.traction(o, &[1e-3, 0.0], H, &mut s);
+        let limit = -sigma * 30f64.to_radians().tan();
+        assert!((t.normal - sigma).abs() < 1e-9 * sigma.abs());
+        assert!(
+            (t.shear_magnitude() - limit).abs() < 1e-9 * limit,
+            "{t:?} vs {limit}"
+        );
+        // Reversing the slip a little unloads elastically.
+        let back = m.traction(o, &[1e-3 - 1e-12, 0.0], H, &mut s);
+        assert!(back.shear_magnitude() < limit);
+        assert!(MohrCoulombJoint::new(30.0, -1.0, 1.0, 1.0).is_err());
+    }
+
     proptest! {
+        /// Friction never exceeds c_r − σ tan φ, and acts along the slip.
+        #[test]
+        fn mohr_coulomb_bounded(path in proptest::collection::vec((-2.0f64..0.5, -3.0f64..3.0, -3.0f64..3.0), 1..40)) {
+            let m = MohrCoulombJoint::new(35.0, 1e5, 3e12, 3e11).unwrap();
+            let mut s = [0.0; 3];
+            for (o, a, b) in path {
+                let t = m.traction(o * 1e-9, &[a * 1e-8, b * 1e-8], H, &mut s);
+                let strength = (m.cohesion - t.normal * 35f64.to_radians().tan()).max(0.0);
+                prop_assert!(t.shear_magnitude() <= strength * (1.0 + 1e-12) + 1e-9);
+                prop_assert!(t.normal <= 0.0);
+            }
+        }
+
         /// D never decreases along an arbitrary path, and a broken joint carries no
         /// tension.
         #[test]
@@ -432,10 +616,10 @@ mod tests {
             let mut s = [0.0; 4];
             let mut d_prev = 0.0;
             for (a, b) in path {
-                let t = m.traction(a * scale_o, b * scale_s, H, &mut s);
+                let t = m.traction(a * scale_o, &[b * scale_s], H, &mut s);
                 prop_assert!(s[czm_state::DAMAGE] >= d_prev);
                 d_prev = s[czm_state::DAMAGE];
-                prop_assert!(t.shear >= 0.0 && t.normal.is_finite());
+                prop_assert!(t.shear_magnitude() >= 0.0 && t.normal.is_finite());
                 if m.is_broken(&s) {
                     prop_assert!(t.normal <= 0.0, "tension {} after break", t.normal);
                 }
@@ -447,9 +631,11 @@ mod tests {
         fn symmetric_in_slip(o in -1.0f64..3.0, sl in 0.0f64..3.0) {
             let m = czm();
             let (o, sl) = (o * m.peak_opening(H), sl * m.peak_slip(H));
-            let a = m.traction(o, sl, H, &mut [0.0; 4]);
-            let b = m.traction(o, -sl, H, &mut [0.0; 4]);
-            prop_assert_eq!(a, b);
+            let a = m.traction(o, &[sl], H, &mut [0.0; 4]);
+            let b = m.traction(o, &[-sl], H, &mut [0.0; 4]);
+            prop_assert_eq!(a.normal, b.normal);
+            prop_assert_eq!(a.shear_magnitude(), b.shear_magnitude());
+            prop_assert_eq!(a.shear[0], -b.shear[0]);
         }
 
         /// After softening to o_u, unloading follows the secant σ(o_u) o / o_u.
@@ -458,12 +644,12 @@ mod tests {
             let m = czm();
             let mut s = [0.0; 4];
             let ou = m.peak_opening(H) + k * m.softening_opening();
-            let at_u = m.traction(ou, 0.0, H, &mut s).normal;
+            let at_u = m.traction(ou, &[0.0], H, &mut s).normal;
             let o = back * ou;
-            let t = m.traction(o, 0.0, H, &mut s).normal;
+            let t = m.traction(o, &[0.0], H, &mut s).normal;
             prop_assert!((t - at_u * o / ou).abs() <= 1e-9 * m.tensile_strength);
             // Reloading to o_u gives back the same traction (no further damage).
-            let again = m.traction(ou, 0.0, H, &mut s).normal;
+            let again = m.traction(ou, &[0.0], H, &mut s).normal;
             prop_assert!((again - at_u).abs() <= 1e-9 * m.tensile_strength);
         }
     }

@@ -114,3 +114,58 @@ fn joint_forces_identical_for_any_thread_count() {
     assert_eq!(a.len(), b.len());
     assert!(a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()));
 }
+
+#[test]
+fn a_pre_existing_fracture_carries_no_tension() {
+    use pcdc_cohesive::{joints_on_fractures, Fracture, MohrCoulombJoint};
+    let mesh = builders::rectangle(0.0, 0.0, 0.02, 0.04, 0.005).unwrap();
+    let split = split_nodes(&mesh, &Range::All).unwrap();
+    let on_crack = joints_on_fractures(
+        &split.mesh,
+        &split.joints,
+        &[Fracture::Segment {
+            a: [0.0, 0.02],
+            b: [0.02, 0.02],
+        }],
+    )
+    .unwrap();
+    assert_eq!(on_crack.len(), 4);
+    let fracture = MohrCoulombJoint::new(30.0, 0.0, 100.0 * E, 10.0 * E).unwrap();
+    let rock = LinearElastic::new(E, 0.25, 2600.0)
+        .unwrap()
+        .with_damping(0.3)
+        .unwrap();
+    let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(2).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(
+            CohesiveJoints::new(split.joints.clone())
+                .model(Range::All, czm())
+                .model_for(on_crack.clone(), fracture),
+        )
+        .physics(
+            Boundary::new()
+                .velocity(Range::group("bottom"), [None, Some(0.0.into()), None])
+                .velocity(Range::group("top"), [None, Some(0.02.into()), None]),
+        )
+        .build()
+        .unwrap();
+    let bottom = sim.mesh().select_nodes(&Range::group("bottom")).unwrap();
+    let mut peak = 0.0f64;
+    for _ in 0..3000 {
+        sim.step().unwrap();
+        let f: f64 = bottom
+            .iter()
+            .map(|&n| sim.node_force()[n as usize * 2 + 1])
+            .sum();
+        peak = peak.max(f / 0.02);
+    }
+    // Only inertia of the lower half is felt; far below the intact strength.
+    assert!(peak < 0.05 * TS, "peak {peak}");
+    let damage = sim.field(JOINT_DAMAGE).unwrap();
+    assert!(on_crack.iter().all(|&j| damage[j as usize] == 1.0));
+    let broken = sim.field(pcdc_cohesive::BROKEN_FACE).unwrap();
+    assert_eq!(
+        broken.iter().filter(|&&b| b == 1.0).count(),
+        2 * on_crack.len()
+    );
+}
