@@ -147,6 +147,26 @@ pub struct IntrinsicCzm {
     /// ∫₀¹ f(D) dD, cached.
     #[serde(skip, default = "softening_integral")]
     softening_work: f64,
+    /// Constants derived from the parameters, cached so that the per-step path
+    /// evaluates one division and no trigonometry (rebuilt on the fly after
+    /// deserialisation).
+    #[serde(skip)]
+    derived: Option<Derived>,
+}
+
+/// Constants of [`IntrinsicCzm`] derived once from its parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Derived {
+    /// o_p / h = 2 T_s / P_open.
+    op_h: f64,
+    /// s_p / h = 2 c / P_tan.
+    sp_h: f64,
+    /// 1 / o_t.
+    inv_ot: f64,
+    /// 1 / s_t.
+    inv_st: f64,
+    /// tan φ.
+    tan_phi: f64,
 }
 
 /// State layout of [`IntrinsicCzm`]: damage D, largest opening, largest slip, failure mode.
@@ -212,7 +232,24 @@ impl IntrinsicCzm {
             penalty_shear,
             penalty_overlap,
             softening_work: softening_integral(),
-        })
+            derived: None,
+        }
+        .with_derived())
+    }
+
+    fn with_derived(mut self) -> Self {
+        self.derived = Some(self.derive());
+        self
+    }
+
+    fn derive(&self) -> Derived {
+        Derived {
+            op_h: 2.0 * self.tensile_strength / self.penalty_open,
+            sp_h: 2.0 * self.cohesion / self.penalty_shear,
+            inv_ot: 1.0 / self.softening_opening(),
+            inv_st: 1.0 / self.softening_slip(),
+            tan_phi: self.friction_deg.to_radians().tan(),
+        }
     }
 
     /// Peak opening o_p = 2 h T_s / P_open (eq. 65), m.
@@ -260,19 +297,16 @@ impl JointModel for IntrinsicCzm {
 
     fn traction(&self, o: f64, slip_vec: &[f64], h: f64, state: &mut [f64]) -> Traction {
         use czm_state::*;
+        let dv = self.derived.unwrap_or_else(|| self.derive());
+        let inv_h = 1.0 / h;
         let slip = slip_vec.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let (op, sp, ov) = (
-            self.peak_opening(h),
-            self.peak_slip(h),
-            self.overlap_length(h),
-        );
-        let (ot, st) = (self.softening_opening(), self.softening_slip());
+        let (op, sp) = (dv.op_h * h, dv.sp_h * h);
         // Damage (eq. 68), irreversible. Before the peak in both modes nothing is
         // evaluated beyond comparisons: an undamaged joint pays no exp/pow.
         let mut d = state[DAMAGE];
         if o > op || slip > sp {
-            let dn = ((o - op) / ot).max(0.0);
-            let ds = ((slip - sp) / st).max(0.0);
+            let dn = ((o - op) * dv.inv_ot).max(0.0);
+            let ds = ((slip - sp) * dv.inv_st).max(0.0);
             let trial = (dn * dn + ds * ds).sqrt().min(1.0);
             if trial > d {
                 d = trial;
@@ -294,31 +328,31 @@ impl JointModel for IntrinsicCzm {
         let su = state[MAX_SLIP].max(slip);
         state[MAX_OPENING] = ou;
         state[MAX_SLIP] = su;
-        // Normal traction (eq. 63, unloading eq. 72).
+        // Normal traction (eq. 63, unloading eq. 72); 2 T_s / o_overlap = P_overlap / h.
         let ts = self.tensile_strength;
         let normal = if o < 0.0 {
-            2.0 * o / ov * ts
+            self.penalty_overlap * o * inv_h
         } else if ou > op && o < ou {
             f * ts * o / ou
         } else if o <= op {
-            rising(o / op) * f * ts
+            rising(o * inv_h / dv.op_h) * f * ts
         } else {
             f * ts
         };
         // Shear strength: Mohr-Coulomb with the softened cohesion (eq. 64).
-        let tan_phi = self.friction_deg.to_radians().tan();
-        let strength = (-normal * tan_phi + f * self.cohesion).max(0.0);
+        let strength = (-normal * dv.tan_phi + f * self.cohesion).max(0.0);
         let shear = if su > sp && slip < su {
             strength * slip / su
         } else if slip <= sp {
-            rising(slip / sp) * strength
+            rising(slip * inv_h / dv.sp_h) * strength
         } else {
             strength
         };
         let mut sv = [0.0; 3];
         if slip > 0.0 {
+            let scale = shear / slip;
             for (k, v) in slip_vec.iter().enumerate() {
-                sv[k] = shear * v / slip;
+                sv[k] = scale * v;
             }
         }
         Traction { normal, shear: sv }

@@ -1,0 +1,69 @@
+//! The standard FDEM benchmark scene of DESIGN.md without contact (which arrives with
+//! pcdc-contact): a 0.05 x 0.10 m block of right triangles, every triangle with its own
+//! nodes, an intrinsic cohesive joint on every interior edge (penalties 10 E, overlap
+//! 100 E, Ts = 2 MPa, c = 10 MPa), E = 30 GPa, nu = 0.25, rho = 2600, bottom fixed in y,
+//! top pushed at 0.05 m/s, dt = 0.05 h / c_p; 10k, 50k and 200k triangles, 1 thread and
+//! all threads.
+//!
+//! Run: `cargo bench --bench fdem_step`. Criterion reports elements/s = triangle-steps/s;
+//! joint-steps/s = triangle-steps/s x joints/triangles (about 1.5), printed once per mesh.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm};
+use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_mech::{Boundary, LinearElastic, Mechanics};
+use pcdc_mesh::{builders, Dim2, Range};
+
+const E: f64 = 30e9;
+
+fn scene(cells_x: usize, threads: usize) -> Simulation<Dim2> {
+    let h = 0.05 / cells_x as f64;
+    let mesh = builders::rectangle(0.0, 0.0, 0.05, 0.10, h).unwrap();
+    let split = split_nodes(&mesh, &Range::All).unwrap();
+    let czm = IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, 10.0 * E, 10.0 * E, 100.0 * E).unwrap();
+    let rock = LinearElastic::new(E, 0.25, 2600.0).unwrap();
+    let c_p = ((rock.lambda() + 2.0 * rock.shear()) / 2600.0).sqrt();
+    Simulation::builder(split.mesh, CpuBackend::new(threads).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
+        .physics(
+            Boundary::new()
+                .velocity(Range::group("bottom"), [None, Some(0.0.into()), None])
+                .velocity(Range::group("top"), [None, Some((-0.05).into()), None]),
+        )
+        .time_step(0.05 * h / c_p)
+        .build()
+        .unwrap()
+}
+
+fn bench(c: &mut Criterion) {
+    let all = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    let mut threads = vec![1];
+    if all > 1 {
+        threads.push(all);
+    }
+    let mut g = c.benchmark_group("fdem_step");
+    g.sample_size(10);
+    g.measurement_time(std::time::Duration::from_secs(6));
+    // nx x 2nx cells of 2 triangles: 50 -> 10k, 112 -> 50k, 224 -> 201k.
+    for nx in [50, 112, 224] {
+        for &t in &threads {
+            let mut sim = scene(nx, t);
+            let n = sim.mesh().n_elements();
+            if t == 1 {
+                let joints = sim.field(pcdc_cohesive::JOINT_DAMAGE).unwrap().len();
+                eprintln!("fdem_step: {n} triangles, {joints} joints ({:.3} joints per triangle), {:.0} B per triangle in the simulation state", joints as f64 / n as f64, sim.state_bytes() as f64 / n as f64);
+            }
+            g.throughput(Throughput::Elements(n as u64));
+            g.bench_function(format!("tri3_{}k_joints_threads_{t}", n / 1000), |b| {
+                b.iter(|| sim.step().unwrap())
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
