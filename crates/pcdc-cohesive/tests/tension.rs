@@ -22,6 +22,17 @@ fn pull<D: Dim>(
     area: f64,
     threads: usize,
 ) -> (f64, usize, Vec<f64>) {
+    pull_with(mesh, bottom, top, area, threads, 3)
+}
+
+fn pull_with<D: Dim>(
+    mesh: Mesh<D>,
+    bottom: &str,
+    top: &str,
+    area: f64,
+    threads: usize,
+    gauss_3d: usize,
+) -> (f64, usize, Vec<f64>) {
     let split = split_nodes(&mesh, &Range::All).unwrap();
     let axis = D::D - 1;
     let mut up = [None, None, None];
@@ -34,7 +45,11 @@ fn pull<D: Dim>(
         .unwrap();
     let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(threads).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new(split.joints.clone()).model(Range::All, czm()))
+        .physics(
+            CohesiveJoints::new(split.joints.clone())
+                .model(Range::All, czm())
+                .gauss_points_3d(gauss_3d),
+        )
         .physics(
             Boundary::new()
                 .velocity(Range::group(bottom), hold)
@@ -88,6 +103,97 @@ fn bar_3d_breaks_at_the_tensile_strength() {
     eprintln!("3D peak {:.3} MPa, broken joints {broken}", peak / 1e6);
     assert!(broken > 0);
     assert!((peak - TS).abs() < 0.10 * TS, "peak {peak} vs Ts {TS}");
+}
+
+#[test]
+fn seven_point_gauss_rule_in_3d_agrees() {
+    let mesh = builders::cuboid([0.0; 3], [0.01, 0.01, 0.02], 0.005).unwrap();
+    let (p3, _, _) = pull_with(mesh.clone(), "zmin", "zmax", 1e-4, 2, 3);
+    let (p7, broken, _) = pull_with(mesh, "zmin", "zmax", 1e-4, 2, 7);
+    assert!(broken > 0);
+    assert!((p7 - TS).abs() < 0.10 * TS, "7-point peak {p7}");
+    assert!((p7 - p3).abs() < 0.02 * TS, "3-point {p3} vs 7-point {p7}");
+}
+
+/// A user-defined joint model plugs in through the trait: a linear elastic-brittle
+/// joint that breaks at a fixed opening.
+#[test]
+fn user_joint_model_plugs_in() {
+    use pcdc_cohesive::{JointModel, Traction};
+    #[derive(Debug)]
+    struct Brittle {
+        stiffness: f64,
+        break_opening: f64,
+    }
+    impl JointModel for Brittle {
+        fn name(&self) -> &str {
+            "brittle"
+        }
+        fn n_state(&self) -> usize {
+            1
+        }
+        fn traction(&self, o: f64, slip: &[f64], _h: f64, state: &mut [f64]) -> Traction {
+            if o > self.break_opening {
+                state[0] = 1.0;
+            }
+            let intact = state[0] < 1.0;
+            let normal = if !intact && o > 0.0 {
+                0.0
+            } else {
+                self.stiffness * o
+            };
+            let mut shear = [0.0; 3];
+            if intact {
+                for (k, s) in slip.iter().enumerate() {
+                    shear[k] = self.stiffness * s;
+                }
+            }
+            Traction { normal, shear }
+        }
+        fn max_stiffness(&self, _h: f64) -> f64 {
+            self.stiffness
+        }
+        fn is_broken(&self, state: &[f64]) -> bool {
+            state[0] >= 1.0
+        }
+    }
+    let mesh = builders::rectangle(0.0, 0.0, 0.02, 0.04, 0.005).unwrap();
+    let split = split_nodes(&mesh, &Range::All).unwrap();
+    let k = 10.0 * E / 0.005;
+    let brittle = Brittle {
+        stiffness: k,
+        break_opening: 1e6 / k,
+    };
+    let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(1).unwrap())
+        .physics(
+            Mechanics::new().material(
+                Range::All,
+                LinearElastic::new(E, 0.25, 2600.0)
+                    .unwrap()
+                    .with_damping(0.3)
+                    .unwrap(),
+            ),
+        )
+        .physics(CohesiveJoints::new(split.joints.clone()).model(Range::All, brittle))
+        .physics(
+            Boundary::new()
+                .velocity(Range::group("bottom"), [None, Some(0.0.into()), None])
+                .velocity(Range::group("top"), [None, Some(0.02.into()), None]),
+        )
+        .build()
+        .unwrap();
+    let bottom = sim.mesh().select_nodes(&Range::group("bottom")).unwrap();
+    let mut peak = 0.0f64;
+    while sim.field(JOINT_DAMAGE).unwrap().iter().all(|&d| d < 1.0) && sim.state.step < 100_000 {
+        sim.step().unwrap();
+        let f: f64 = bottom
+            .iter()
+            .map(|&n| sim.node_force()[n as usize * 2 + 1])
+            .sum();
+        peak = peak.max(f / 0.02);
+    }
+    // Breaks at the opening where its traction reaches 1 MPa.
+    assert!((peak - 1e6).abs() < 0.1e6, "peak {peak}");
 }
 
 #[test]
