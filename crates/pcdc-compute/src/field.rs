@@ -146,6 +146,17 @@ impl FieldStore {
         out.map(|o| o.expect("field id from this store"))
     }
 
+    /// Whether another store has the same declarations and array lengths.
+    pub fn same_layout(&self, other: &FieldStore) -> bool {
+        self.specs == other.specs
+            && self.data.len() == other.data.len()
+            && self
+                .data
+                .iter()
+                .zip(&other.data)
+                .all(|(a, b)| a.len() == b.len())
+    }
+
     /// Total bytes held by all fields.
     pub fn bytes(&self) -> usize {
         self.data.iter().map(|d| d.len() * 8).sum()

@@ -526,8 +526,19 @@ impl<D: Dim> Simulation<D, CpuBackend> {
                 snap.physics, names
             ));
         }
-        if snap.state.fields.specs() != self.state.fields.specs() {
+        if !snap.state.fields.same_layout(&self.state.fields) {
             return mismatch("field layouts differ".to_string());
+        }
+        if snap.state.u.len() != self.state.u.len() || snap.state.v.len() != self.state.v.len() {
+            return mismatch(format!(
+                "node arrays hold {} and {} values, expected {}",
+                snap.state.u.len(),
+                snap.state.v.len(),
+                self.state.u.len()
+            ));
+        }
+        if !(snap.dt > 0.0 && snap.dt.is_finite()) {
+            return mismatch(format!("time step {} is not positive", snap.dt));
         }
         self.state = snap.state;
         self.dt = snap.dt;

@@ -665,3 +665,20 @@ fn history_csv_and_vtu_series() {
     assert!(bad.sample(&sim).is_err());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn corrupted_snapshots_are_errors() {
+    let a = loaded_block(1);
+    let bytes = a.snapshot_bytes().unwrap();
+    let mut b = loaded_block(1);
+    for cut in [0, 1, 10, bytes.len() / 2, bytes.len() - 1] {
+        assert!(b.restore_bytes(&bytes[..cut]).is_err(), "cut at {cut}");
+    }
+    let mut flipped = bytes.clone();
+    for i in (0..flipped.len()).step_by(97) {
+        flipped[i] ^= 0x5a;
+    }
+    // Either refused or accepted with a consistent layout; never a panic.
+    let _ = b.restore_bytes(&flipped);
+    assert!(matches!(b.restore("/nonexistent/dir/x.snap"), Err(ComputeError::Io { .. })));
+}
