@@ -294,8 +294,9 @@ impl<D: Dim> Simulation<D, CpuBackend> {
 
     /// Advances one explicit step.
     pub fn step(&mut self) -> Result<(), ComputeError> {
-        self.compute_forces(false)?;
-        self.integrate()
+        self.physics_forces()?;
+        self.gather(true);
+        self.finish_step()
     }
 
     /// Advances `n` steps.
@@ -326,6 +327,27 @@ impl<D: Dim> Simulation<D, CpuBackend> {
     /// (`gross = true` also returns the sum of absolute slot contributions per dof).
     pub(crate) fn compute_forces(&mut self, gross: bool) -> Result<Option<Vec<f64>>, ComputeError> {
         let d = D::D;
+        self.physics_forces()?;
+        self.gather(false);
+        let (ptr, idx, slots) = (&self.gather_ptr, &self.gather_idx, &self.slot_forces);
+        let force = &self.force;
+        if !gross {
+            return Ok(None);
+        }
+        let mut g = vec![0.0; force.len()];
+        for n in 0..self.mesh.n_nodes() {
+            for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
+                for k in 0..d {
+                    g[n * d + k] += slots[s as usize * d + k].abs();
+                }
+            }
+        }
+        Ok(Some(g))
+    }
+
+    /// Clears the force slots and lets every physics write its forces.
+    fn physics_forces(&mut self) -> Result<(), ComputeError> {
+        let d = D::D;
         let kin_u = &self.state.u;
         let kin_v = &self.state.v;
         let fields = &mut self.state.fields;
@@ -348,61 +370,55 @@ impl<D: Dim> Simulation<D, CpuBackend> {
             };
             p.compute_forces(&mut ctx)?;
         }
-        let (ptr, idx, slots) = (&self.gather_ptr, &self.gather_idx, &self.slot_forces);
-        let force = &mut self.force;
-        self.backend.install(|| {
-            force
-                .par_chunks_mut(d)
-                .enumerate()
-                .with_min_len(1024)
-                .for_each(|(n, f)| {
-                    f.fill(0.0);
-                    for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
-                        for k in 0..d {
-                            f[k] += slots[s as usize * d + k];
-                        }
-                    }
-                })
-        });
-        if !gross {
-            return Ok(None);
-        }
-        let mut g = vec![0.0; force.len()];
-        for n in 0..self.mesh.n_nodes() {
-            for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
-                for k in 0..d {
-                    g[n * d + k] += slots[s as usize * d + k].abs();
-                }
-            }
-        }
-        Ok(Some(g))
+        Ok(())
     }
 
-    /// Central-difference update from the gathered force, kinematic conditions, position
-    /// update and watchdog.
-    pub(crate) fn integrate(&mut self) -> Result<(), ComputeError> {
+    /// Each node sums its slots in registration order into the node force; with
+    /// `integrate_velocity` the same pass applies the central-difference velocity update
+    /// `v += dt (F + m_phys g − α|F| sign v) / m` (one pass over the nodes instead of two).
+    fn gather(&mut self, integrate_velocity: bool) {
         let d = D::D;
         let dt = self.dt;
         let g = self.gravity;
         let alpha = self.local_damping;
-        let (force, mass, mass_phys) = (&self.force, &self.mass, &self.mass_phys);
+        let (ptr, idx, slots) = (&self.gather_ptr, &self.gather_idx, &self.slot_forces);
+        let (mass, mass_phys) = (&self.mass, &self.mass_phys);
+        let force = &mut self.force;
         let v = &mut self.state.v;
         self.backend.install(|| {
-            v.par_chunks_mut(d)
+            force
+                .par_chunks_mut(d)
+                .zip(v.par_chunks_mut(d))
                 .enumerate()
                 .with_min_len(1024)
-                .for_each(|(n, vn)| {
-                    let (m, w) = (mass[n], mass_phys[n] / mass[n]);
-                    for k in 0..d {
-                        let mut f = force[n * d + k] + w * m * g[k];
-                        if alpha > 0.0 {
-                            // Local non-viscous damping (Cundall): f -= α |f| sign(v).
-                            f -= alpha * f.abs() * vn[k].signum() * (vn[k] != 0.0) as u8 as f64;
+                .for_each(|(n, (f, vn))| {
+                    let mut sum = [0.0; 3];
+                    for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
+                        for k in 0..d {
+                            sum[k] += slots[s as usize * d + k];
                         }
-                        vn[k] += dt * f / m;
+                    }
+                    f.copy_from_slice(&sum[..d]);
+                    if integrate_velocity {
+                        let (m, w) = (mass[n], mass_phys[n] / mass[n]);
+                        for k in 0..d {
+                            let mut fk = sum[k] + w * m * g[k];
+                            if alpha > 0.0 {
+                                // Local non-viscous damping (Cundall): f -= α |f| sign(v).
+                                fk -=
+                                    alpha * fk.abs() * vn[k].signum() * (vn[k] != 0.0) as u8 as f64;
+                            }
+                            vn[k] += dt * fk / m;
+                        }
                     }
                 })
         });
+    }
+
+    /// Kinematic conditions, position update and watchdog after the velocity update.
+    fn finish_step(&mut self) -> Result<(), ComputeError> {
+        let d = D::D;
+        let dt = self.dt;
         let t_end = self.state.time + dt;
         for p in &self.physics {
             let mut ctx = VelocityContext {

@@ -127,8 +127,7 @@ impl<D: Dim> Simulation<D, CpuBackend> {
     ) -> Result<StaticReport, ComputeError> {
         let mut ratio = f64::INFINITY;
         for it in 1..=opts.max_steps {
-            self.compute_forces(false)?;
-            self.integrate()?;
+            self.step()?;
             if it % opts.check_every == 0 {
                 ratio = self.unbalanced_ratio(free)?;
                 if ratio <= opts.tolerance {

@@ -680,5 +680,8 @@ fn corrupted_snapshots_are_errors() {
     }
     // Either refused or accepted with a consistent layout; never a panic.
     let _ = b.restore_bytes(&flipped);
-    assert!(matches!(b.restore("/nonexistent/dir/x.snap"), Err(ComputeError::Io { .. })));
+    assert!(matches!(
+        b.restore("/nonexistent/dir/x.snap"),
+        Err(ComputeError::Io { .. })
+    ));
 }
