@@ -132,6 +132,16 @@ impl CohesiveJoints {
         &self.joints
     }
 
+    /// History variables per Gauss point: the largest of the assigned models (≥ 1).
+    fn assigned_state_len(&self) -> usize {
+        self.assignments
+            .iter()
+            .map(|a| a.1.n_state())
+            .max()
+            .unwrap_or(1)
+            .max(1)
+    }
+
     fn state_stride(&self) -> usize {
         self.rule.len() * self.n_state
     }
@@ -200,17 +210,10 @@ impl<D: Dim> Physics<D, CpuBackend> for CohesiveJoints {
         "cohesive joints"
     }
 
-    fn fields(&self, mesh: &Mesh<D>) -> Vec<FieldSpec> {
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
         let points = if D::D == 2 { 3 } else { self.gauss_3d };
-        let ns = self
-            .assignments
-            .iter()
-            .map(|a| a.1.n_state())
-            .max()
-            .unwrap_or(1)
-            .max(1);
+        let ns = self.assigned_state_len();
         let nj = self.joints.len();
-        let _ = mesh; // joints are counted by the physics, faces by the mesh
         vec![
             FieldSpec::new(JOINT_STATE, Location::Entities(nj), points * ns),
             FieldSpec::new(JOINT_DAMAGE, Location::Entities(nj), 1),
@@ -259,13 +262,7 @@ impl<D: Dim> Physics<D, CpuBackend> for CohesiveJoints {
             }
         }
         self.rule = gauss_rule(d, self.gauss_3d);
-        self.n_state = self
-            .assignments
-            .iter()
-            .map(|a| a.1.n_state())
-            .max()
-            .unwrap_or(1)
-            .max(1);
+        self.n_state = self.assigned_state_len();
         self.models = self.assignments.iter().map(|a| a.1.clone()).collect();
         // Model per joint by the midpoint of its side A.
         let mut model_of = vec![u16::MAX; nj];
