@@ -9,6 +9,8 @@
 // Index loops mirror the formulas.
 #![allow(clippy::needless_range_loop)]
 
+mod physics;
 mod potential2d;
 
+pub use physics::{Contact, CONTACT_REFERENCE};
 pub use potential2d::{potential, triangle_pair_force, PairForce2};
