@@ -28,14 +28,90 @@ use crate::triangle_pair_force;
 /// Node positions at the last broad-phase build (m), stride D.
 pub const CONTACT_REFERENCE: &str = "contact_reference_positions";
 
+/// Adds the Coulomb friction of eq. 59-60 to a pair's normal forces: the tangential
+/// force `min(k_t |δ_s|, tan φ |F_n|)` opposes the accumulated slip δ_s (which grows with
+/// the relative sliding velocity and is reset to the Coulomb limit when sliding, eq. 60),
+/// with `k_t = P_t h²`. It is distributed over each triangle's nodes in proportion to
+/// that triangle's share of the normal force (equal and opposite totals).
+fn add_friction<D: Dim>(
+    pair: &mut crate::PairForce2,
+    kin: &Kinematics<'_, D>,
+    c: usize,
+    t: usize,
+    fr: Friction,
+    h: f64,
+    slip: &mut f64,
+) {
+    let fc = [
+        pair.contactor.iter().map(|v| v[0]).sum::<f64>(),
+        pair.contactor.iter().map(|v| v[1]).sum::<f64>(),
+    ];
+    let fn_mag = (fc[0] * fc[0] + fc[1] * fc[1]).sqrt();
+    if fn_mag == 0.0 {
+        *slip = 0.0;
+        return;
+    }
+    let n = [fc[0] / fn_mag, fc[1] / fn_mag];
+    let tang = [-n[1], n[0]];
+    let weights = |forces: &[[f64; 2]; 3]| {
+        let w: [f64; 3] = std::array::from_fn(|a| {
+            (forces[a][0] * forces[a][0] + forces[a][1] * forces[a][1]).sqrt()
+        });
+        let sum: f64 = w.iter().sum();
+        w.map(|x| if sum > 0.0 { x / sum } else { 1.0 / 3.0 })
+    };
+    let (wc, wt) = (weights(&pair.contactor), weights(&pair.target));
+    let vel = |e: usize, w: &[f64; 3]| {
+        let conn = kin.mesh.element(e);
+        let mut v = [0.0; 2];
+        for a in 0..3 {
+            for d in 0..2 {
+                v[d] += w[a] * kin.v[conn[a] as usize * D::D + d];
+            }
+        }
+        v
+    };
+    let (vc, vt) = (vel(c, &wc), vel(t, &wt));
+    let v_rel = (vc[0] - vt[0]) * tang[0] + (vc[1] - vt[1]) * tang[1];
+    *slip += v_rel * kin.dt;
+    let kt = fr.penalty * h * h;
+    let limit = fr.angle_deg.to_radians().tan() * fn_mag;
+    let mut ft = kt * slip.abs();
+    if ft > limit {
+        ft = limit;
+        *slip = slip.signum() * limit / kt;
+    }
+    let ft = -slip.signum() * ft;
+    for a in 0..3 {
+        for d in 0..2 {
+            pair.contactor[a][d] += wc[a] * ft * tang[d];
+            pair.target[a][d] -= wt[a] * ft * tang[d];
+        }
+    }
+}
+
 /// Potential contact between all elements of the mesh (2D).
 #[derive(Debug)]
 pub struct Contact {
     penalty: f64,
+    friction: Option<Friction>,
     skin: Option<f64>,
     skin_used: f64,
     reference: Option<FieldId>,
     candidates: Mutex<Vec<Vec<u32>>>,
+    /// Accumulated tangential slip δ_s (m) per element and candidate (same order as the
+    /// candidate lists); both elements of a pair update identical copies.
+    slips: Mutex<Vec<Vec<f64>>>,
+}
+
+/// Coulomb friction with a shear penalty (manual eq. 59-60).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Friction {
+    /// Friction angle φ (degrees).
+    pub angle_deg: f64,
+    /// Shear penalty P_t (Pa/m): the tangential stiffness of a contact of length h is
+    /// P_t h² (N/m per unit thickness), h the mean edge length of the two elements.
+    pub penalty: f64,
 }
 
 impl Contact {
@@ -43,11 +119,22 @@ impl Contact {
     pub fn new(penalty: f64) -> Self {
         Contact {
             penalty,
+            friction: None,
             skin: None,
             skin_used: 0.0,
             reference: None,
             candidates: Mutex::new(Vec::new()),
+            slips: Mutex::new(Vec::new()),
         }
+    }
+
+    /// Adds Coulomb friction (eq. 59-60).
+    pub fn friction(mut self, angle_deg: f64, shear_penalty: f64) -> Self {
+        self.friction = Some(Friction {
+            angle_deg,
+            penalty: shear_penalty,
+        });
+        self
     }
 
     /// Skin distance of the broad phase (m); default half the smallest element edge.
@@ -166,6 +253,22 @@ impl<D: Dim> Physics<D, CpuBackend> for Contact {
                 "must be positive and finite",
             ));
         }
+        if let Some(f) = self.friction {
+            if !(0.0..90.0).contains(&f.angle_deg) {
+                return Err(ComputeError::param(
+                    "contact friction angle",
+                    f.angle_deg,
+                    "must lie in [0, 90) degrees",
+                ));
+            }
+            if !(f.penalty > 0.0 && f.penalty.is_finite()) {
+                return Err(ComputeError::param(
+                    "contact shear penalty",
+                    f.penalty,
+                    "must be positive and finite",
+                ));
+            }
+        }
         let (lo, _) = ctx.mesh.edge_length_range();
         self.skin_used = self.skin.unwrap_or(0.5 * lo);
         if !(self.skin_used > 0.0 && self.skin_used.is_finite()) {
@@ -216,30 +319,65 @@ impl<D: Dim> Physics<D, CpuBackend> for Contact {
         let mut cand = self.candidates.lock().map_err(|_| {
             ComputeError::physics("contact", "candidate lists poisoned by an earlier panic")
         })?;
+        let mut slips = self.slips.lock().map_err(|_| {
+            ComputeError::physics("contact", "slip state poisoned by an earlier panic")
+        })?;
         if moved || cand.len() != kin.mesh.n_elements() {
-            *cand = ctx.backend.install(|| self.build(kin));
+            let fresh = ctx.backend.install(|| self.build(kin));
+            // Carry the accumulated slip of pairs that stay candidates.
+            let mut new_slips: Vec<Vec<f64>> = fresh.iter().map(|l| vec![0.0; l.len()]).collect();
+            if slips.len() == cand.len() {
+                for e in 0..fresh.len().min(cand.len()) {
+                    for (k, f) in fresh[e].iter().enumerate() {
+                        if let Ok(old) = cand[e].binary_search(f) {
+                            new_slips[e][k] = slips[e][old];
+                        }
+                    }
+                }
+            }
+            *cand = fresh;
+            *slips = new_slips;
             for n in 0..kin.mesh.n_nodes() {
                 reference[2 * n] = kin.x(n, 0);
                 reference[2 * n + 1] = kin.x(n, 1);
             }
         }
         let lists = &*cand;
+        let slips: &mut Vec<Vec<f64>> = &mut slips;
         let penalty = self.penalty;
+        let friction = self.friction;
+        let mean_edge = |e: usize| {
+            let t = Self::element_xy(kin, e);
+            (0..3)
+                .map(|a| {
+                    ((t[(a + 1) % 3][0] - t[a][0]).powi(2) + (t[(a + 1) % 3][1] - t[a][1]).powi(2))
+                        .sqrt()
+                })
+                .sum::<f64>()
+                / 3.0
+        };
         ctx.backend.install(|| {
             ctx.slots
                 .par_chunks_mut(6)
+                .zip(slips.par_iter_mut())
                 .enumerate()
-                .for_each(|(e, slot)| {
+                .for_each(|(e, (slot, slip))| {
                     let me = Self::element_xy(kin, e);
-                    for &f in &lists[e] {
+                    for (k, &f) in lists[e].iter().enumerate() {
                         let f = f as usize;
                         let other = Self::element_xy(kin, f);
                         // Canonical order: the lower index is the contactor.
-                        let share = if e < f {
-                            triangle_pair_force(&me, &other, penalty).contactor
+                        let (c, t, ci, ti) = if e < f {
+                            (&me, &other, e, f)
                         } else {
-                            triangle_pair_force(&other, &me, penalty).target
+                            (&other, &me, f, e)
                         };
+                        let mut pair = triangle_pair_force(c, t, penalty);
+                        if let Some(fr) = friction {
+                            let h = 0.5 * (mean_edge(ci) + mean_edge(ti));
+                            add_friction(&mut pair, kin, ci, ti, fr, h, &mut slip[k]);
+                        }
+                        let share = if e < f { pair.contactor } else { pair.target };
                         for a in 0..3 {
                             slot[2 * a] += share[a][0];
                             slot[2 * a + 1] += share[a][1];
