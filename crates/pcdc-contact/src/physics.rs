@@ -388,3 +388,52 @@ impl<D: Dim> Physics<D, CpuBackend> for Contact {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pcdc_mesh::Dim2;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Friction never exceeds tan φ times the normal force, and once sliding it
+        /// opposes the relative sliding velocity of the contactor.
+        #[test]
+        fn friction_bounded_and_opposing(dx in -0.3f64..0.3, dy in 0.75f64..0.95, vx in -2.0f64..2.0, vy in -0.5f64..0.5, phi in 5.0f64..60.0) {
+            // Target: lower triangle; contactor: the upper one, overlapping its top edge.
+            let coords = vec![0.0, 0.0, 2.0, 0.0, 1.0, 1.0, dx, dy, 2.0 + dx, dy, 1.0 + dx, 1.0 + dy];
+            let mesh = Mesh::<Dim2>::new(coords.clone(), vec![0, 1, 2, 3, 4, 5]).unwrap();
+            let u = vec![0.0; 12];
+            let mut v = vec![0.0; 12];
+            for n in 3..6 {
+                v[2 * n] = vx;
+                v[2 * n + 1] = vy;
+            }
+            let mass = vec![1.0; 6];
+            let kin = Kinematics { mesh: &mesh, mass: &mass, u: &u, v: &v, time: 0.0, dt: 1e-3, step: 0, damping: false };
+            let c = Contact::element_xy(&kin, 1);
+            let t = Contact::element_xy(&kin, 0);
+            let fr = Friction { angle_deg: phi, penalty: 1e9 };
+            let mut slip = 0.0;
+            for _ in 0..50 {
+                let normal = triangle_pair_force(&c, &t, 1e9);
+                prop_assume!(normal.contactor.iter().any(|f| f[0] != 0.0 || f[1] != 0.0));
+                let mut pair = normal;
+                add_friction(&mut pair, &kin, 1, 0, fr, 1.0, &mut slip);
+                let sum = |p: &[[f64; 2]; 3]| [p.iter().map(|f| f[0]).sum::<f64>(), p.iter().map(|f| f[1]).sum::<f64>()];
+                let (fn_, ft_all) = (sum(&normal.contactor), sum(&pair.contactor));
+                let ft = [ft_all[0] - fn_[0], ft_all[1] - fn_[1]];
+                let n_mag = fn_[0].hypot(fn_[1]);
+                let t_mag = ft[0].hypot(ft[1]);
+                prop_assert!(t_mag <= phi.to_radians().tan() * n_mag * (1.0 + 1e-12));
+                // Tangential part of the relative velocity (contactor minus target).
+                let nn = [fn_[0] / n_mag, fn_[1] / n_mag];
+                let vt = [vx - (vx * nn[0] + vy * nn[1]) * nn[0], vy - (vx * nn[0] + vy * nn[1]) * nn[1]];
+                prop_assert!(ft[0] * vt[0] + ft[1] * vt[1] <= 1e-9 * t_mag.max(1.0), "friction {:?} along sliding {:?}", ft, vt);
+                // Action equals reaction.
+                let (tc, tt) = (sum(&pair.contactor), sum(&pair.target));
+                prop_assert!((tc[0] + tt[0]).abs() < 1e-9 * n_mag && (tc[1] + tt[1]).abs() < 1e-9 * n_mag);
+            }
+        }
+    }
+}
