@@ -37,6 +37,7 @@
 
 pub use pcdc_cohesive as cohesive;
 pub use pcdc_compute as compute;
+pub use pcdc_contact as contact;
 pub use pcdc_mech as mech;
 pub use pcdc_mesh as mesh;
 

@@ -84,3 +84,20 @@ fn direct_tension_peak_at_ts_and_crack_across_the_neck() {
         dt::NECK
     );
 }
+
+#[test]
+fn block_sliding_stops_within_3_percent() {
+    use pcdc::scenes::block_sliding;
+    for v0 in [1.0, 2.0] {
+        let o = block_sliding::run(v0, 2).unwrap();
+        eprintln!(
+            "block sliding v0 {v0}: {:.5} m vs {:.5} m ({:.3} %), {} steps, {:.1} s",
+            o.distance,
+            o.expected,
+            100.0 * o.error,
+            o.steps,
+            o.wall_s
+        );
+        assert!(o.error <= block_sliding::TOL, "v0 {v0}: error {}", o.error);
+    }
+}

@@ -2,6 +2,7 @@
 //! form and returns the measured error. Examples run them at full size and print the
 //! `RESULT` line; tests run them at reduced size and assert the same tolerance.
 
+pub mod block_sliding;
 pub mod direct_tension;
 pub mod kirsch;
 pub mod vibration_energy;
