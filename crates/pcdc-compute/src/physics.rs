@@ -191,6 +191,17 @@ pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
     /// Kinematic constraints for the direct static solve.
     fn dof_constraints(&self, _mesh: &Mesh<D>, _out: &mut Vec<DofConstraint>) {}
 
+    /// State this physics keeps outside the fields (e.g. contact pair histories), encoded
+    /// for a snapshot; the default has none.
+    fn save_state(&self) -> Result<Vec<u8>, ComputeError> {
+        Ok(Vec::new())
+    }
+
+    /// Restores what [`Physics::save_state`] wrote.
+    fn restore_state(&mut self, _bytes: &[u8]) -> Result<(), ComputeError> {
+        Ok(())
+    }
+
     /// Energy stored by this physics (J), e.g. elastic strain energy; used by energy checks.
     fn stored_energy(&self, _kin: &Kinematics<'_, D>, _fields: &FieldStore) -> f64 {
         0.0

@@ -282,9 +282,11 @@ struct Snapshot {
     physics: Vec<String>,
     dt: f64,
     state: State,
+    /// Per physics, the state it keeps outside the fields.
+    physics_state: Vec<Vec<u8>>,
 }
 
-const SNAPSHOT_MAGIC: &str = "pcdc-snapshot-1";
+const SNAPSHOT_MAGIC: &str = "pcdc-snapshot-2";
 
 impl<D: Dim> Simulation<D, CpuBackend> {
     /// Starts a builder on the CPU backend.
@@ -502,6 +504,11 @@ impl<D: Dim> Simulation<D, CpuBackend> {
             physics: self.physics.iter().map(|p| p.name().to_string()).collect(),
             dt: self.dt,
             state: self.state.clone(),
+            physics_state: self
+                .physics
+                .iter()
+                .map(|p| p.save_state())
+                .collect::<Result<_, _>>()?,
         };
         postcard::to_stdvec(&snap).map_err(|e| ComputeError::Encoding(e.to_string()))
     }
@@ -555,6 +562,12 @@ impl<D: Dim> Simulation<D, CpuBackend> {
         }
         if !(snap.dt > 0.0 && snap.dt.is_finite()) {
             return mismatch(format!("time step {} is not positive", snap.dt));
+        }
+        if snap.physics_state.len() != self.physics.len() {
+            return mismatch("physics state count differs".to_string());
+        }
+        for (p, bytes) in self.physics.iter_mut().zip(&snap.physics_state) {
+            p.restore_state(bytes)?;
         }
         self.state = snap.state;
         self.dt = snap.dt;

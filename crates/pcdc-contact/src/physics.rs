@@ -283,6 +283,61 @@ impl<D: Dim> Physics<D, CpuBackend> for Contact {
         Ok(())
     }
 
+    fn save_state(&self) -> Result<Vec<u8>, ComputeError> {
+        // Candidate lists and accumulated slips, little-endian: count, then per element
+        // its list length, partners (u32) and slips (f64).
+        let poisoned = || ComputeError::physics("contact", "state poisoned by an earlier panic");
+        let cand = self.candidates.lock().map_err(|_| poisoned())?;
+        let slips = self.slips.lock().map_err(|_| poisoned())?;
+        let mut out = Vec::new();
+        out.extend_from_slice(&(cand.len() as u64).to_le_bytes());
+        for (list, slip) in cand
+            .iter()
+            .zip(slips.iter().chain(std::iter::repeat(&Vec::new())))
+        {
+            out.extend_from_slice(&(list.len() as u64).to_le_bytes());
+            for f in list {
+                out.extend_from_slice(&f.to_le_bytes());
+            }
+            for k in 0..list.len() {
+                out.extend_from_slice(&slip.get(k).copied().unwrap_or(0.0).to_le_bytes());
+            }
+        }
+        Ok(out)
+    }
+
+    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), ComputeError> {
+        let bad = || ComputeError::SnapshotMismatch("contact state is truncated or corrupt".into());
+        let mut pos = 0usize;
+        let mut take = |n: usize| -> Result<&[u8], ComputeError> {
+            let s = bytes.get(pos..pos + n).ok_or_else(bad)?;
+            pos += n;
+            Ok(s)
+        };
+        let count = u64::from_le_bytes(take(8)?.try_into().map_err(|_| bad())?) as usize;
+        if count > bytes.len() {
+            return Err(bad());
+        }
+        let (mut cand, mut slips) = (Vec::with_capacity(count), Vec::with_capacity(count));
+        for _ in 0..count {
+            let len = u64::from_le_bytes(take(8)?.try_into().map_err(|_| bad())?) as usize;
+            if len > bytes.len() {
+                return Err(bad());
+            }
+            let list: Vec<u32> = (0..len)
+                .map(|_| take(4).map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes"))))
+                .collect::<Result<_, _>>()?;
+            let slip: Vec<f64> = (0..len)
+                .map(|_| take(8).map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes"))))
+                .collect::<Result<_, _>>()?;
+            cand.push(list);
+            slips.push(slip);
+        }
+        *self.candidates.get_mut().map_err(|_| bad())? = cand;
+        *self.slips.get_mut().map_err(|_| bad())? = slips;
+        Ok(())
+    }
+
     fn stable_step(&self, kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
         // A node pushed by the potential of a neighbour's sub-triangle (gradient 3/h over
         // an edge of length ~h) sees a stiffness of about 3 p per unit thickness.
