@@ -51,12 +51,7 @@ pub fn expected(v0: f64) -> f64 {
 fn block_on_base(size: f64, length: f64) -> Result<Mesh<Dim2>, SceneError> {
     let base = builders::rectangle(0.0, 0.0, length, BASE_TOP, size)?;
     let block = builders::rectangle(0.05, BASE_TOP, 0.1, 0.05, size)?;
-    let mut coords = base.coords().to_vec();
-    coords.extend_from_slice(block.coords());
-    let off = base.n_nodes() as u32;
-    let mut conn = base.elements().to_vec();
-    conn.extend(block.elements().iter().map(|n| n + off));
-    Ok(Mesh::new(coords, conn)?)
+    Ok(builders::union(&[&base, &block])?.0)
 }
 
 /// Runs one initial speed `v0` (m/s) on `threads` threads (0 = all cores).

@@ -157,6 +157,17 @@ impl FractureNetwork {
         min: &[f64],
         max: &[f64],
     ) -> Result<Vec<Fracture>, CohesiveError> {
+        let d = D::D;
+        if min.len() < d
+            || max.len() < d
+            || (0..d).any(|k| !(min[k].is_finite() && max[k].is_finite() && min[k] <= max[k]))
+        {
+            return Err(CohesiveError::InvalidParameter {
+                name: "fracture network box",
+                value: f64::NAN,
+                reason: "needs D finite components in min and max with min <= max",
+            });
+        }
         self.orientation.check("fracture orientation")?;
         self.azimuth.check("fracture azimuth")?;
         self.length.check("fracture length")?;
@@ -167,7 +178,6 @@ impl FractureNetwork {
                 reason: "must be non-negative and finite",
             });
         }
-        let d = D::D;
         let measure: f64 = (0..d).map(|k| (max[k] - min[k]).max(0.0)).product();
         let count = (self.density * measure).round() as usize;
         if count > 10_000_000 {

@@ -12,12 +12,7 @@ const E: f64 = 1e9;
 fn two_blocks() -> Mesh<Dim2> {
     let a = builders::rectangle(0.0, 0.0, 0.1, 0.1, 0.02).unwrap();
     let b = builders::rectangle(0.102, 0.0, 0.1, 0.1, 0.02).unwrap();
-    let mut coords = a.coords().to_vec();
-    coords.extend_from_slice(b.coords());
-    let off = a.n_nodes() as u32;
-    let mut conn = a.elements().to_vec();
-    conn.extend(b.elements().iter().map(|n| n + off));
-    Mesh::new(coords, conn).unwrap()
+    builders::union(&[&a, &b]).unwrap().0
 }
 
 fn run(threads: usize) -> (Simulation<Dim2>, f64, f64, f64) {

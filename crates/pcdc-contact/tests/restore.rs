@@ -4,17 +4,13 @@
 use pcdc_compute::{CpuBackend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Dim2, Mesh, Range};
+use pcdc_mesh::{builders, Dim2, Range};
 
 fn scene() -> Simulation<Dim2> {
     let base = builders::rectangle(0.0, 0.0, 0.4, 0.05, 0.025).unwrap();
     let block = builders::rectangle(0.05, 0.05, 0.1, 0.05, 0.025).unwrap();
-    let mut coords = base.coords().to_vec();
-    coords.extend_from_slice(block.coords());
     let off = base.n_nodes() as u32;
-    let mut conn = base.elements().to_vec();
-    conn.extend(block.elements().iter().map(|n| n + off));
-    let mesh = Mesh::new(coords, conn).unwrap();
+    let mesh = builders::union(&[&base, &block]).unwrap().0;
     let rock = LinearElastic::new(1e8, 0.25, 1000.0)
         .unwrap()
         .with_damping(1.0)

@@ -24,14 +24,7 @@ fn stack() -> (Mesh<Dim2>, Vec<Vec<u32>>) {
             .unwrap(),
         );
     }
-    let (mut coords, mut conn, mut groups) = (Vec::new(), Vec::new(), Vec::new());
-    for b in &bodies {
-        let off = (coords.len() / 2) as u32;
-        groups.push((0..b.n_nodes() as u32).map(|n| n + off).collect());
-        coords.extend_from_slice(b.coords());
-        conn.extend(b.elements().iter().map(|n| n + off));
-    }
-    (Mesh::new(coords, conn).unwrap(), groups)
+    builders::union(&bodies.iter().collect::<Vec<_>>()).unwrap()
 }
 
 #[test]

@@ -1414,3 +1414,38 @@ mod tests {
         assert!(worst.iter().all(|&q| q > 10.0));
     }
 }
+
+/// Joins separate bodies into one mesh (nodes and elements concatenated in order, node
+/// indices offset), e.g. a block resting on a base for contact. Bodies keep their own
+/// nodes, so they interact only through contact. Returns the mesh and, per body, its
+/// node indices in the joined mesh; groups of the inputs are not carried over.
+pub fn union<D: Dim>(bodies: &[&Mesh<D>]) -> Result<(Mesh<D>, Vec<Vec<u32>>), MeshError> {
+    if bodies.is_empty() {
+        return Err(MeshError::Empty);
+    }
+    let (mut coords, mut conn, mut nodes) = (Vec::new(), Vec::new(), Vec::new());
+    for b in bodies {
+        let off = (coords.len() / D::D) as u32;
+        nodes.push((off..off + b.n_nodes() as u32).collect());
+        coords.extend_from_slice(b.coords());
+        conn.extend(b.elements().iter().map(|n| n + off));
+    }
+    Ok((Mesh::new(coords, conn)?, nodes))
+}
+
+#[cfg(test)]
+mod union_tests {
+    use super::*;
+
+    #[test]
+    fn union_keeps_bodies_apart() {
+        let a = rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        let b = rectangle(2.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        let (m, nodes) = union(&[&a, &b]).unwrap();
+        assert_eq!(m.n_nodes(), a.n_nodes() + b.n_nodes());
+        assert_eq!(m.n_elements(), a.n_elements() + b.n_elements());
+        assert_eq!(nodes[1][0] as usize, a.n_nodes());
+        assert!(nodes[1].iter().all(|&n| m.node(n as usize)[0] >= 2.0));
+        assert!(union::<Dim2>(&[]).is_err());
+    }
+}
