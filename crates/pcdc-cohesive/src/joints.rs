@@ -15,7 +15,7 @@
 use std::sync::Arc;
 
 use pcdc_compute::{
-    ComputeError, CpuBackend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
+    ComputeError, Backend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
     Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
@@ -205,7 +205,7 @@ impl CohesiveJoints {
     }
 }
 
-impl<D: Dim> Physics<D, CpuBackend> for CohesiveJoints {
+impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
     fn name(&self) -> &str {
         "cohesive joints"
     }
@@ -367,7 +367,7 @@ impl<D: Dim> Physics<D, CpuBackend> for CohesiveJoints {
 
     fn compute_forces(
         &self,
-        ctx: &mut ForceContext<'_, D, CpuBackend>,
+        ctx: &mut ForceContext<'_, D, B>,
     ) -> Result<(), ComputeError> {
         let [sid, did, bid] = self.ids.expect("init ran");
         let (d, npf) = (D::D, D::NODES_PER_FACE);

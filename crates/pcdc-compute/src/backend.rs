@@ -13,6 +13,8 @@ use crate::ComputeError;
 pub enum BackendKind {
     /// rayon on the CPU (the reference backend).
     Cpu,
+    /// wgpu on a GPU (or lavapipe).
+    Gpu,
 }
 
 impl BackendKind {
@@ -20,12 +22,13 @@ impl BackendKind {
     pub fn name(self) -> &'static str {
         match self {
             BackendKind::Cpu => "cpu",
+            BackendKind::Gpu => "gpu",
         }
     }
 }
 
 /// A compute backend. Physics implement [`crate::Physics`] for each backend they support.
-pub trait Backend: Send + Sync + 'static {
+pub trait Backend: Send + Sync + Clone + 'static {
     /// The kind of this backend.
     fn kind(&self) -> BackendKind;
     /// Number of worker threads (CPU) or 1 (GPU queue).
@@ -33,6 +36,13 @@ pub trait Backend: Send + Sync + 'static {
     /// Floating-point precision name (`f64` or `f32`).
     fn precision(&self) -> &'static str {
         "f64"
+    }
+    /// Runs host-side work `f` (rayon parallel iterators inside use this backend's CPU
+    /// pool: the CPU backend's own, or the GPU backend's host pool).
+    fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R;
+    /// The GPU backend, when this is one.
+    fn as_gpu(&self) -> Option<&crate::gpu::WgpuBackend> {
+        None
     }
 }
 
@@ -77,11 +87,6 @@ impl CpuBackend {
         })
     }
 
-    /// Runs `f` inside this backend's thread pool (rayon parallel iterators used in `f`
-    /// run on its threads).
-    pub fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
-        self.pool.install(f)
-    }
 }
 
 impl Backend for CpuBackend {
@@ -90,5 +95,8 @@ impl Backend for CpuBackend {
     }
     fn threads(&self) -> usize {
         self.threads
+    }
+    fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
+        self.pool.install(f)
     }
 }

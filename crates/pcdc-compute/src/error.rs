@@ -57,6 +57,12 @@ pub enum ComputeError {
     /// Snapshot (de)serialisation failed.
     #[error("snapshot encoding: {0}")]
     Encoding(String),
+    /// The GPU backend failed (no adapter, limits, shader or device error).
+    #[error("GPU backend: {0}")]
+    Gpu(String),
+    /// A composed physics (or one of its models) has no GPU kernel.
+    #[error("physics '{physics}' cannot run on the GPU backend: {reason}. Hint: use the CPU backend (--backend cpu) or give the model a WGSL body")]
+    NoGpuKernel { physics: String, reason: String },
     /// A physics-specific error.
     #[error("{physics}: {message}")]
     Physics { physics: String, message: String },

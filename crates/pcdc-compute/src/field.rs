@@ -64,6 +64,13 @@ impl FieldSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct FieldId(usize);
 
+impl FieldId {
+    /// Position of the field in declaration order.
+    pub fn index(self) -> usize {
+        self.0
+    }
+}
+
 /// The declared fields of a simulation.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct FieldStore {

@@ -18,6 +18,7 @@
 mod backend;
 mod error;
 mod field;
+pub mod gpu;
 mod history;
 mod physics;
 mod simulation;
@@ -25,6 +26,7 @@ mod statics;
 mod table;
 
 pub use backend::{Backend, BackendKind, CpuBackend};
+pub use gpu::{BackendChoice, Precision, WgpuBackend};
 pub use error::ComputeError;
 pub use field::{names, FieldId, FieldSpec, FieldStore, Location};
 pub use history::{History, Probe};

@@ -202,6 +202,18 @@ pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
         Ok(())
     }
 
+    /// Declares this physics' GPU kernels, data and signals (GPU backend only); the
+    /// kernels must compute exactly what [`Physics::compute_forces`] and
+    /// [`Physics::apply_kinematics`] compute on the host. The default refuses, so that a
+    /// physics without kernels is an error when the simulation is built, never a silent
+    /// fallback.
+    fn gpu_setup(&mut self, _setup: &mut crate::gpu::GpuSetup<'_, D>) -> Result<(), ComputeError> {
+        Err(ComputeError::NoGpuKernel {
+            physics: self.name().to_string(),
+            reason: "it has no GPU kernels yet".to_string(),
+        })
+    }
+
     /// Energy stored by this physics (J), e.g. elastic strain energy; used by energy checks.
     fn stored_energy(&self, _kin: &Kinematics<'_, D>, _fields: &FieldStore) -> f64 {
         0.0

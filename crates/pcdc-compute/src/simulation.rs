@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::physics::{ForceContext, InitContext, Kinematics, VelocityContext};
+use crate::gpu::GpuRun;
 use crate::{Backend, ComputeError, CpuBackend, FieldStore, Physics, StableStep};
 
 /// Default safety factor applied to the critical time step.
@@ -165,45 +166,8 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             ));
         }
         let n_nodes = mesh.n_nodes();
-        let mut fields = FieldStore::default();
-        for p in &physics {
-            for spec in p.fields(&mesh) {
-                let count = match spec.location {
-                    crate::Location::Node => n_nodes,
-                    crate::Location::Element => mesh.n_elements(),
-                    crate::Location::Face => mesh.faces().len(),
-                    crate::Location::Entities(n) => n,
-                };
-                fields.declare(spec, count)?;
-            }
-        }
-        let mut slot_ranges = Vec::with_capacity(physics.len());
-        let mut slot_nodes = Vec::new();
-        for p in physics.iter_mut() {
-            let mut ctx = InitContext {
-                mesh: &mesh,
-                fields: &mut fields,
-                slot_nodes: Vec::new(),
-            };
-            p.init(&mut ctx)?;
-            let first = slot_nodes.len();
-            slot_nodes.extend_from_slice(&ctx.slot_nodes);
-            slot_ranges.push(first..slot_nodes.len());
-        }
-        // CSR node -> slots, slots in ascending (registration) order.
-        let mut gather_ptr = vec![0u32; n_nodes + 1];
-        for &n in &slot_nodes {
-            gather_ptr[n as usize + 1] += 1;
-        }
-        for i in 0..n_nodes {
-            gather_ptr[i + 1] += gather_ptr[i];
-        }
-        let mut fill = gather_ptr.clone();
-        let mut gather_idx = vec![0u32; slot_nodes.len()];
-        for (s, &n) in slot_nodes.iter().enumerate() {
-            gather_idx[fill[n as usize] as usize] = s as u32;
-            fill[n as usize] += 1;
-        }
+        let layout = prepare_layout(&mesh, &mut physics)?;
+        let fields = layout.fields.clone();
         let mut mass = vec![0.0; n_nodes];
         for p in &physics {
             p.add_mass(&mesh, &fields, &mut mass, None);
@@ -227,10 +191,11 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             mass_phys: mass.clone(),
             mass,
             force: vec![0.0; n_nodes * d],
-            slot_forces: vec![0.0; slot_nodes.len() * d],
-            slot_ranges,
-            gather_ptr,
-            gather_idx,
+            slot_forces: vec![0.0; layout.n_slots * d],
+            slot_ranges: layout.slot_ranges.clone(),
+            gather_ptr: layout.gather_ptr.clone(),
+            gather_idx: layout.gather_idx.clone(),
+            gpu: None,
             mesh,
             backend,
             physics,
@@ -244,8 +209,74 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             local_damping,
         };
         sim.update_time_step()?;
+        if let Some(gpu) = sim.backend.as_gpu().cloned() {
+            sim.gpu = Some(Box::new(GpuRun::new(&gpu, &mut sim, &layout)?));
+        }
         Ok(sim)
     }
+}
+
+/// Fields, slots and the node -> slot gather lists of a composition.
+pub(crate) struct Layout {
+    pub fields: FieldStore,
+    pub slot_ranges: Vec<std::ops::Range<usize>>,
+    pub n_slots: usize,
+    pub gather_ptr: Vec<u32>,
+    pub gather_idx: Vec<u32>,
+}
+
+/// Declares the fields of every physics, initialises them in order (registering their
+/// slots) and builds the CSR node -> slots lists (slots in registration order).
+pub(crate) fn prepare_layout<D: Dim, B: Backend>(
+    mesh: &Mesh<D>,
+    physics: &mut [Box<dyn Physics<D, B>>],
+) -> Result<Layout, ComputeError> {
+    let n_nodes = mesh.n_nodes();
+    let mut fields = FieldStore::default();
+    for p in physics.iter() {
+        for spec in p.fields(mesh) {
+            let count = match spec.location {
+                crate::Location::Node => n_nodes,
+                crate::Location::Element => mesh.n_elements(),
+                crate::Location::Face => mesh.faces().len(),
+                crate::Location::Entities(n) => n,
+            };
+            fields.declare(spec, count)?;
+        }
+    }
+    let mut slot_ranges = Vec::with_capacity(physics.len());
+    let mut slot_nodes = Vec::new();
+    for p in physics.iter_mut() {
+        let mut ctx = InitContext {
+            mesh,
+            fields: &mut fields,
+            slot_nodes: Vec::new(),
+        };
+        p.init(&mut ctx)?;
+        let first = slot_nodes.len();
+        slot_nodes.extend_from_slice(&ctx.slot_nodes);
+        slot_ranges.push(first..slot_nodes.len());
+    }
+    let mut gather_ptr = vec![0u32; n_nodes + 1];
+    for &n in &slot_nodes {
+        gather_ptr[n as usize + 1] += 1;
+    }
+    for i in 0..n_nodes {
+        gather_ptr[i + 1] += gather_ptr[i];
+    }
+    let mut fill = gather_ptr.clone();
+    let mut gather_idx = vec![0u32; slot_nodes.len()];
+    for (s, &n) in slot_nodes.iter().enumerate() {
+        gather_idx[fill[n as usize] as usize] = s as u32;
+        fill[n as usize] += 1;
+    }
+    Ok(Layout {
+        fields,
+        slot_ranges,
+        n_slots: slot_nodes.len(),
+        gather_ptr,
+        gather_idx,
+    })
 }
 
 /// A running simulation.
@@ -270,6 +301,8 @@ pub struct Simulation<D: Dim, B: Backend = CpuBackend> {
     pub(crate) limit: Option<StableStep>,
     pub(crate) damping: bool,
     pub(crate) local_damping: f64,
+    /// Device state on the GPU backend.
+    pub(crate) gpu: Option<Box<GpuRun>>,
 }
 
 /// Snapshot file header, checked on restore.
@@ -288,21 +321,33 @@ struct Snapshot {
 
 const SNAPSHOT_MAGIC: &str = "pcdc-snapshot-2";
 
-impl<D: Dim> Simulation<D, CpuBackend> {
-    /// Starts a builder on the CPU backend.
-    pub fn builder(mesh: Mesh<D>, backend: CpuBackend) -> SimulationBuilder<D, CpuBackend> {
+impl<D: Dim, B: Backend> Simulation<D, B> {
+    /// Starts a builder on `backend` ([`CpuBackend`] or [`crate::WgpuBackend`]).
+    pub fn builder(mesh: Mesh<D>, backend: B) -> SimulationBuilder<D, B> {
         SimulationBuilder::new(mesh, backend)
     }
 
-    /// Advances one explicit step.
+    /// Advances one explicit step. On the GPU backend this is `run(1)` (one read-back);
+    /// prefer [`Simulation::run`] with many steps there.
     pub fn step(&mut self) -> Result<(), ComputeError> {
+        if self.gpu.is_some() {
+            return self.run(1);
+        }
         self.physics_forces()?;
         self.gather(true);
         self.finish_step()
     }
 
-    /// Advances `n` steps.
+    /// Advances `n` steps. On the GPU backend the host state (`state`, masses) is
+    /// uploaded at the start, the `n` steps run on the device without any read, and the
+    /// state is read back once at the end; the watchdog's verdict arrives then, naming the
+    /// first bad step and node.
     pub fn run(&mut self, n: u64) -> Result<(), ComputeError> {
+        if let Some(mut gpu) = self.gpu.take() {
+            let r = gpu.run(self, n);
+            self.gpu = Some(gpu);
+            return r;
+        }
         for _ in 0..n {
             self.step()?;
         }
@@ -311,10 +356,23 @@ impl<D: Dim> Simulation<D, CpuBackend> {
 
     /// Advances until `time` (s) is reached (the last step may overshoot by < dt).
     pub fn run_until(&mut self, time: f64) -> Result<(), ComputeError> {
+        if self.gpu.is_some() {
+            let (mut t, mut n) = (self.state.time, 0u64);
+            while t < time {
+                t += self.dt;
+                n += 1;
+            }
+            return self.run(n);
+        }
         while self.state.time < time {
             self.step()?;
         }
         Ok(())
+    }
+
+    /// Labels of the GPU kernels in dispatch order (empty on the CPU backend).
+    pub fn gpu_kernels(&self) -> Vec<String> {
+        self.gpu.as_ref().map(|g| g.kernel_labels()).unwrap_or_default()
     }
 
     /// Evaluates every physics' forces at the current state without advancing, and
@@ -328,6 +386,11 @@ impl<D: Dim> Simulation<D, CpuBackend> {
     /// Evaluates all forces at the current state and gathers them into the node force
     /// (`gross = true` also returns the sum of absolute slot contributions per dof).
     pub(crate) fn compute_forces(&mut self, gross: bool) -> Result<Option<Vec<f64>>, ComputeError> {
+        if let Some(mut gpu) = self.gpu.take() {
+            let r = gpu.evaluate(self, gross);
+            self.gpu = Some(gpu);
+            return r;
+        }
         let d = D::D;
         self.physics_forces()?;
         self.gather(false);
@@ -461,27 +524,32 @@ impl<D: Dim> Simulation<D, CpuBackend> {
         self.state.time = t_end;
         self.state.step += 1;
         if let Some((n, nonfinite)) = bad {
-            let hint = match &self.limit {
-                Some(l) => format!(
-                    "time step {:e} s (limit set by {} of {}); check that the time step is not above the stable one, that penalties are not extreme, and that loads and boundary conditions are sensible",
-                    self.dt, l.entity, l.physics
-                ),
-                None => "check the time step and the boundary conditions".to_string(),
-            };
-            let what = if nonfinite {
-                "non-finite (NaN or infinite) velocity or displacement".to_string()
-            } else {
-                format!("runaway displacement above {:e} m", self.runaway)
-            };
-            return Err(ComputeError::Diverged {
-                step: self.state.step,
-                time: self.state.time,
-                what,
-                entity: format!("node {n}"),
-                hint,
-            });
+            return Err(self.divergence(self.state.step, self.state.time, n, nonfinite));
         }
         Ok(())
+    }
+
+    /// The divergence error for node `n` at `step` (time `time`).
+    pub(crate) fn divergence(&self, step: u64, time: f64, n: usize, nonfinite: bool) -> ComputeError {
+        let hint = match &self.limit {
+            Some(l) => format!(
+                "time step {:e} s (limit set by {} of {}); check that the time step is not above the stable one, that penalties are not extreme, and that loads and boundary conditions are sensible",
+                self.dt, l.entity, l.physics
+            ),
+            None => "check the time step and the boundary conditions".to_string(),
+        };
+        let what = if nonfinite {
+            "non-finite (NaN or infinite) velocity or displacement".to_string()
+        } else {
+            format!("runaway displacement above {:e} m", self.runaway)
+        };
+        ComputeError::Diverged {
+            step,
+            time,
+            what,
+            entity: format!("node {n}"),
+            hint,
+        }
     }
 
     /// Saves the running state to a file (postcard binary); see [`Simulation::restore`].
@@ -576,7 +644,8 @@ impl<D: Dim> Simulation<D, CpuBackend> {
 }
 
 impl<D: Dim, B: Backend> Simulation<D, B> {
-    /// Read-only view of the current kinematic state.
+    /// Read-only view of the current kinematic state (on the GPU backend: as read back at
+    /// the end of the last run).
     pub fn kinematics(&self) -> Kinematics<'_, D> {
         Kinematics {
             mesh: &self.mesh,

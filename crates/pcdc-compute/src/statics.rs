@@ -17,7 +17,7 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 
 use crate::physics::DofConstraint;
-use crate::{ComputeError, CpuBackend, Simulation};
+use crate::{Backend, ComputeError, Simulation};
 use pcdc_mesh::Dim;
 
 /// Local damping coefficient used by dynamic relaxation.
@@ -53,15 +53,18 @@ pub struct StaticReport {
     pub ratio: f64,
 }
 
-impl<D: Dim> Simulation<D, CpuBackend> {
+impl<D: Dim, B: Backend> Simulation<D, B> {
     /// Unbalanced-force ratio at the current state, ignoring constrained dofs.
     fn unbalanced_ratio(&mut self, free: &[bool]) -> Result<f64, ComputeError> {
         let gross = self.compute_forces(true)?.expect("gross requested");
+        let d = D::D;
         let (mut num, mut den) = (0.0, 0.0);
         for (i, (&f, &g)) in self.force.iter().zip(&gross).enumerate() {
             if free[i] {
-                num += f * f;
-                den += g * g;
+                // Gravity is a load like any other.
+                let w = self.mass_phys[i / d] * self.gravity[i % d];
+                num += (f + w) * (f + w);
+                den += (g + w.abs()) * (g + w.abs());
             }
         }
         Ok(if den > 0.0 {
@@ -126,8 +129,12 @@ impl<D: Dim> Simulation<D, CpuBackend> {
         free: &[bool],
     ) -> Result<StaticReport, ComputeError> {
         let mut ratio = f64::INFINITY;
-        for it in 1..=opts.max_steps {
-            self.step()?;
+        let mut it = 0;
+        while it < opts.max_steps {
+            // Whole check intervals at once: on the GPU they run without a read-back.
+            let k = opts.check_every.min(opts.max_steps - it);
+            self.run(k)?;
+            it += k;
             if it % opts.check_every == 0 {
                 ratio = self.unbalanced_ratio(free)?;
                 if ratio <= opts.tolerance {
@@ -217,7 +224,8 @@ impl<D: Dim> Simulation<D, CpuBackend> {
             let mut rhs = faer::Mat::<f64>::from_fn(nfree, 1, |i, _| 0.0 * i as f64);
             for i in 0..ndof {
                 if map[i] != usize::MAX {
-                    rhs[(map[i], 0)] = self.force[i];
+                    // Internal and applied forces plus gravity.
+                    rhs[(map[i], 0)] = self.force[i] + self.mass_phys[i / d] * self.gravity[i % d];
                 }
             }
             llt.solve_in_place(rhs.as_mut());

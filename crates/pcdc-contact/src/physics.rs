@@ -17,7 +17,7 @@
 use std::sync::Mutex;
 
 use pcdc_compute::{
-    ComputeError, CpuBackend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
+    ComputeError, Backend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
     Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh};
@@ -227,7 +227,7 @@ impl Contact {
     }
 }
 
-impl<D: Dim> Physics<D, CpuBackend> for Contact {
+impl<D: Dim, B: Backend> Physics<D, B> for Contact {
     fn name(&self) -> &str {
         "contact"
     }
@@ -358,7 +358,7 @@ impl<D: Dim> Physics<D, CpuBackend> for Contact {
 
     fn compute_forces(
         &self,
-        ctx: &mut ForceContext<'_, D, CpuBackend>,
+        ctx: &mut ForceContext<'_, D, B>,
     ) -> Result<(), ComputeError> {
         let rid = self.reference.expect("init ran");
         let kin = &ctx.kin;

@@ -1,7 +1,7 @@
 //! Resets between stages (manual 7.2.8): node velocity, node displacement and element
 //! state. Also used to give nodes an initial velocity.
 
-use pcdc_compute::{names, CpuBackend, Simulation};
+use pcdc_compute::{names, Backend, Simulation};
 use pcdc_mesh::{Dim, Range};
 
 use crate::MechError;
@@ -10,8 +10,8 @@ use crate::MechError;
 pub const DISPLACEMENT_RESET: &str = "displacement_reset";
 
 /// Sets the velocity (m/s) of every node in `range` (first `D` components used).
-pub fn set_velocity<D: Dim>(
-    sim: &mut Simulation<D, CpuBackend>,
+pub fn set_velocity<D: Dim, B: Backend>(
+    sim: &mut Simulation<D, B>,
     range: &Range,
     velocity: [f64; 3],
 ) -> Result<usize, MechError> {
@@ -31,8 +31,8 @@ pub fn set_velocity<D: Dim>(
 }
 
 /// Zeroes the velocity of every node in `range`.
-pub fn reset_velocity<D: Dim>(
-    sim: &mut Simulation<D, CpuBackend>,
+pub fn reset_velocity<D: Dim, B: Backend>(
+    sim: &mut Simulation<D, B>,
     range: &Range,
 ) -> Result<usize, MechError> {
     set_velocity(sim, range, [0.0; 3])
@@ -41,8 +41,8 @@ pub fn reset_velocity<D: Dim>(
 /// Resets the reported displacement of the nodes in `range` to zero without moving them:
 /// the current displacement is remembered in the `displacement_reset` field (declared by
 /// [`crate::Mechanics`]) and subtracted by [`crate::output::displacement`].
-pub fn reset_displacement<D: Dim>(
-    sim: &mut Simulation<D, CpuBackend>,
+pub fn reset_displacement<D: Dim, B: Backend>(
+    sim: &mut Simulation<D, B>,
     range: &Range,
 ) -> Result<usize, MechError> {
     let nodes = sim.mesh().select_nodes(range)?;
@@ -59,8 +59,8 @@ pub fn reset_displacement<D: Dim>(
 
 /// Resets the stress and the constitutive history variables of the elements in `range`
 /// to zero (the current shape becomes stress-free).
-pub fn reset_element_state<D: Dim>(
-    sim: &mut Simulation<D, CpuBackend>,
+pub fn reset_element_state<D: Dim, B: Backend>(
+    sim: &mut Simulation<D, B>,
     range: &Range,
 ) -> Result<usize, MechError> {
     let elems = sim.mesh().select_elements(range)?;

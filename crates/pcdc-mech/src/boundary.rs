@@ -8,7 +8,7 @@
 //! compressive far-field stress or a pressure is therefore negative.
 
 use pcdc_compute::{
-    ComputeError, CpuBackend, DofConstraint, FieldId, FieldSpec, FieldStore, ForceContext,
+    ComputeError, Backend, DofConstraint, FieldId, FieldSpec, FieldStore, ForceContext,
     InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
@@ -201,7 +201,7 @@ fn unit<D: Dim>(d: &[f64; 3]) -> [f64; 3] {
     out
 }
 
-impl<D: Dim> Physics<D, CpuBackend> for Boundary {
+impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
     fn name(&self) -> &str {
         "mechanical boundary"
     }
@@ -273,7 +273,7 @@ impl<D: Dim> Physics<D, CpuBackend> for Boundary {
 
     fn compute_forces(
         &self,
-        ctx: &mut ForceContext<'_, D, CpuBackend>,
+        ctx: &mut ForceContext<'_, D, B>,
     ) -> Result<(), ComputeError> {
         let d = D::D;
         let t = ctx.kin.time;

@@ -11,7 +11,7 @@
 use std::sync::Arc;
 
 use pcdc_compute::{
-    names, ComputeError, CpuBackend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
+    names, ComputeError, Backend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
     Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
@@ -387,7 +387,7 @@ impl Mechanics {
     }
 }
 
-impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
+impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
     fn name(&self) -> &str {
         "mechanics"
     }
@@ -549,7 +549,7 @@ impl<D: Dim> Physics<D, CpuBackend> for Mechanics {
 
     fn compute_forces(
         &self,
-        ctx: &mut ForceContext<'_, D, CpuBackend>,
+        ctx: &mut ForceContext<'_, D, B>,
     ) -> Result<(), ComputeError> {
         let ids = self.ids();
         let (d, npe, nsym) = (D::D, D::NODES_PER_ELEM, D::NSYM);

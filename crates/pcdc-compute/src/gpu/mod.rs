@@ -1,0 +1,31 @@
+//! The GPU backend on wgpu (Vulkan, Metal, DX12; Mesa's lavapipe on machines without a
+//! GPU).
+//!
+//! * [`WgpuBackend`] picks an adapter (`WGPU_ADAPTER_NAME` narrows the choice by name,
+//!   `WGPU_BACKEND` by API), creates a device with the adapter's own limits and runs in
+//!   f64 when the adapter has `SHADER_F64`, in f32 otherwise or on request.
+//! * Physics contribute WGSL kernels through [`crate::Physics::gpu_setup`] with a
+//!   [`GpuSetup`]: they upload constant data, name the fields they touch and add kernels
+//!   to the force or the kinematics phase. The backend owns every buffer, builds the
+//!   pipelines and records whole batches of steps without reading anything back.
+//! * One shader template serves both precisions: every module starts with
+//!   `alias Real = f64;` (or `f32`) and the same prelude ([`assemble_source`]).
+//! * Fields stay on the device during a run; [`crate::Simulation::run`] uploads the host
+//!   state at its start and reads it back once at its end (output, histories, save).
+//!   [`WgpuBackend::readbacks`] counts the device-to-host reads so tests can prove that
+//!   no read happens inside the step loop.
+//!
+//! No kernel uses float atomics: forces go to per-contributor slots and every node sums
+//! its slots in a fixed order, exactly as on the CPU; the only atomics are the integer
+//! `atomicMin`s of the divergence watchdog.
+
+mod backend;
+mod program;
+mod run;
+
+pub use backend::{gpu_test_backend, BackendChoice, Precision, WgpuBackend};
+pub use program::{
+    assemble_source, offline_kernel_sources, validate_wgsl, Access, ConstValue, GpuBuffer,
+    GpuData, GpuSetup, Kernel, Phase, PRELUDE,
+};
+pub(crate) use run::GpuRun;

@@ -1,0 +1,395 @@
+//! What physics declare for the GPU: buffers, kernels and per-step signals; and the
+//! shader template every kernel is assembled into.
+
+use pcdc_mesh::{Dim, Mesh};
+
+use super::Precision;
+use crate::{ComputeError, FieldStore};
+
+/// Data uploaded once when the simulation is built.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GpuData {
+    /// Reals (stored as f64 or f32 by precision); WGSL type `array<Real>`.
+    Real(Vec<f64>),
+    /// Unsigned integers; WGSL type `array<u32>`.
+    U32(Vec<u32>),
+}
+
+impl GpuData {
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            GpuData::Real(v) => v.len(),
+            GpuData::U32(v) => v.len(),
+        }
+    }
+}
+
+/// Handle to a device buffer of a simulation (a field, a built-in array or uploaded data).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GpuBuffer(pub(crate) usize);
+
+/// How a kernel binds a buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    /// `var<storage, read>`.
+    Read,
+    /// `var<storage, read_write>`.
+    ReadWrite,
+}
+
+/// When a kernel runs within a step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// Force phase: writes the physics' force slots (every slot, every step) and its fields.
+    Forces,
+    /// After the velocity update, before the position update: prescribed velocities and
+    /// constraints overwrite `v`.
+    Kinematics,
+}
+
+/// A constant spliced into a kernel's source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConstValue {
+    /// `const NAME: u32 = value;`
+    U32(u32),
+    /// `const NAME: Real = value;` (written with 17 significant digits).
+    Real(f64),
+}
+
+/// A compute kernel: one invocation per entity `i < count`. `source` defines
+/// `fn kernel(i: u32)`, and may define helpers; the backend prepends the prelude
+/// ([`PRELUDE`]), the constants and one storage binding per entry of `bindings`.
+#[derive(Clone, Debug)]
+pub struct Kernel {
+    /// Label (pipeline name in errors and traces).
+    pub label: String,
+    /// WGSL defining `fn kernel(i: u32)`.
+    pub source: String,
+    /// Number of invocations.
+    pub count: u32,
+    /// Bindings: WGSL name, buffer, access.
+    pub bindings: Vec<(String, GpuBuffer, Access)>,
+    /// Constants: WGSL name and value.
+    pub constants: Vec<(String, ConstValue)>,
+}
+
+impl Kernel {
+    /// A kernel with no bindings yet.
+    pub fn new(label: impl Into<String>, source: impl Into<String>, count: usize) -> Self {
+        Kernel {
+            label: label.into(),
+            source: source.into(),
+            count: count as u32,
+            bindings: Vec::new(),
+            constants: Vec::new(),
+        }
+    }
+
+    /// Binds `buffer` as `name`.
+    pub fn bind(mut self, name: &str, buffer: GpuBuffer, access: Access) -> Self {
+        self.bindings.push((name.to_string(), buffer, access));
+        self
+    }
+
+    /// Adds a `u32` constant.
+    pub fn const_u32(mut self, name: &str, v: u32) -> Self {
+        self.constants.push((name.to_string(), ConstValue::U32(v)));
+        self
+    }
+
+    /// Adds a `Real` constant.
+    pub fn const_real(mut self, name: &str, v: f64) -> Self {
+        self.constants.push((name.to_string(), ConstValue::Real(v)));
+        self
+    }
+}
+
+/// Element type of a device buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Elem {
+    Real,
+    U32,
+    Atomic,
+}
+
+/// A buffer the simulation will create.
+#[derive(Clone, Debug)]
+pub(crate) struct BufferDecl {
+    pub label: String,
+    pub elem: Elem,
+    pub len: usize,
+    pub data: Option<GpuData>,
+}
+
+/// A per-step scalar evaluated on the host (e.g. a table value) and shipped with the
+/// step parameters; arguments: time at the start of the step (s) and the step (s).
+pub(crate) type Signal = Box<dyn Fn(f64, f64) -> f64 + Send + Sync>;
+
+/// Built-in buffers, in this order, before the fields and the uploaded data.
+pub(crate) mod builtin {
+    pub const COORDS: usize = 0;
+    pub const DISPLACEMENT: usize = 1;
+    pub const VELOCITY: usize = 2;
+    pub const MASS: usize = 3;
+    pub const MASS_PHYS: usize = 4;
+    pub const FORCE: usize = 5;
+    pub const SLOTS: usize = 6;
+    pub const GATHER_PTR: usize = 7;
+    pub const GATHER_IDX: usize = 8;
+    pub const STATUS: usize = 9;
+    pub const GROSS: usize = 10;
+    pub const COUNT: usize = 11;
+}
+
+/// The GPU program of a simulation: buffers, kernels by phase and physics, signals.
+pub(crate) struct Program {
+    pub buffers: Vec<BufferDecl>,
+    /// Buffer index of each field (FieldStore order).
+    pub field_buffers: Vec<usize>,
+    pub kernels: Vec<(Phase, Kernel)>,
+    pub signals: Vec<Signal>,
+}
+
+/// Handed to [`crate::Physics::gpu_setup`]: declare data, kernels and signals.
+pub struct GpuSetup<'a, D: Dim> {
+    /// The mesh.
+    pub mesh: &'a Mesh<D>,
+    /// The fields with their initial values.
+    pub fields: &'a FieldStore,
+    pub(crate) precision: Precision,
+    pub(crate) slot_first: usize,
+    pub(crate) slot_len: usize,
+    pub(crate) program: &'a mut Program,
+    pub(crate) physics: String,
+}
+
+impl<D: Dim> GpuSetup<'_, D> {
+    /// Kernel precision.
+    pub fn precision(&self) -> Precision {
+        self.precision
+    }
+
+    /// Uploads constant data (connectivity, geometry, parameters).
+    pub fn upload(&mut self, label: &str, data: GpuData) -> GpuBuffer {
+        let elem = match data {
+            GpuData::Real(_) => Elem::Real,
+            GpuData::U32(_) => Elem::U32,
+        };
+        self.program.buffers.push(BufferDecl {
+            label: format!("{}: {label}", self.physics),
+            elem,
+            len: data.len(),
+            data: Some(data),
+        });
+        GpuBuffer(self.program.buffers.len() - 1)
+    }
+
+    /// The device buffer of a declared field (`array<Real>`, same layout as on the host).
+    pub fn field(&self, name: &str) -> Result<GpuBuffer, ComputeError> {
+        let id = self.fields.id(name)?;
+        Ok(GpuBuffer(self.program.field_buffers[id.index()]))
+    }
+
+    /// Reference node coordinates (m), `array<Real>`, stride D.
+    pub fn coords(&self) -> GpuBuffer {
+        GpuBuffer(builtin::COORDS)
+    }
+
+    /// Node displacement (m), `array<Real>`, stride D.
+    pub fn displacement(&self) -> GpuBuffer {
+        GpuBuffer(builtin::DISPLACEMENT)
+    }
+
+    /// Node velocity (m/s), `array<Real>`, stride D.
+    pub fn velocity(&self) -> GpuBuffer {
+        GpuBuffer(builtin::VELOCITY)
+    }
+
+    /// Physical lumped node mass (kg), `array<Real>`.
+    pub fn mass(&self) -> GpuBuffer {
+        GpuBuffer(builtin::MASS_PHYS)
+    }
+
+    /// All force slots (N), `array<Real>`, stride D; this physics owns slots
+    /// `slot_first()..slot_first() + slot_count()` and must write each of them every step.
+    pub fn slots(&self) -> GpuBuffer {
+        GpuBuffer(builtin::SLOTS)
+    }
+
+    /// First slot of this physics.
+    pub fn slot_first(&self) -> u32 {
+        self.slot_first as u32
+    }
+
+    /// Number of slots of this physics.
+    pub fn slot_count(&self) -> usize {
+        self.slot_len
+    }
+
+    /// A per-step scalar: `f(t, dt)` is evaluated on the host for every step (t = time at
+    /// the start of the step) and read in WGSL as `signal(index)`. Use it for time tables.
+    pub fn signal(&mut self, f: impl Fn(f64, f64) -> f64 + Send + Sync + 'static) -> u32 {
+        self.program.signals.push(Box::new(f));
+        (self.program.signals.len() - 1) as u32
+    }
+
+    /// Adds a kernel to a phase; kernels run in the order they are added, physics in
+    /// the order they were composed.
+    pub fn kernel(&mut self, phase: Phase, kernel: Kernel) -> Result<(), ComputeError> {
+        for (name, b, _) in &kernel.bindings {
+            if b.0 >= self.program.buffers.len() {
+                return Err(ComputeError::Gpu(format!(
+                    "kernel '{}' binds '{name}' to an unknown buffer",
+                    kernel.label
+                )));
+            }
+        }
+        self.program.kernels.push((phase, kernel));
+        Ok(())
+    }
+}
+
+/// The prelude of every module (after `alias Real = ...;`): the per-step parameters and
+/// the entry point that calls `kernel(i)` for `i < COUNT`.
+///
+/// Per-step record (`params`, bound with a dynamic offset): `p_time()` time at the start
+/// of the step (s), `p_dt()` step (s), `p_damping()` element viscous damping on,
+/// `p_alpha()` local damping coefficient, `p_gravity(k)` (m/s²), `p_step()` global step
+/// number, `signal(i)` host-evaluated scalars.
+pub const PRELUDE: &str = r#"
+@group(0) @binding(0) var<storage, read> params: array<Real>;
+fn p_time() -> Real { return params[0]; }
+fn p_dt() -> Real { return params[1]; }
+fn p_damping() -> bool { return params[2] != 0.0; }
+fn p_alpha() -> Real { return params[3]; }
+fn p_gravity(k: u32) -> Real { return params[4u + k]; }
+fn p_step() -> u32 { return u32(params[7]) * 4096u + u32(params[8]); }
+fn signal(i: u32) -> Real { return params[PARAM_HEADER + i]; }
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
+    if i < COUNT {
+        kernel(i);
+    }
+}
+"#;
+
+/// Reals in the fixed head of a step record.
+pub(crate) const PARAM_HEADER: usize = 9;
+
+fn real_literal(v: f64, p: Precision) -> String {
+    let v = if p == Precision::F32 { v as f32 as f64 } else { v };
+    if v.is_finite() {
+        let s = format!("{v:.17e}");
+        format!("Real({s})")
+    } else if v > 0.0 {
+        "Real(1e300)".into()
+    } else {
+        "Real(-1e300)".into()
+    }
+}
+
+/// The full WGSL module of a kernel: precision alias, constants, bindings, prelude and
+/// the kernel's source. `elems` gives the element type of each bound buffer.
+pub(crate) fn assemble(
+    kernel: &Kernel,
+    precision: Precision,
+    elems: &dyn Fn(GpuBuffer) -> Elem,
+) -> String {
+    let mut s = String::new();
+    s.push_str(&format!("alias Real = {};\n", precision.name()));
+    let eps = match precision {
+        Precision::F64 => "2.220446049250313e-16",
+        Precision::F32 => "1.1920929e-7",
+    };
+    s.push_str(&format!("const REAL_EPS: Real = Real({eps});\n"));
+    s.push_str(&format!("const COUNT: u32 = {}u;\n", kernel.count));
+    s.push_str(&format!("const PARAM_HEADER: u32 = {PARAM_HEADER}u;\n"));
+    for (name, v) in &kernel.constants {
+        match v {
+            ConstValue::U32(x) => s.push_str(&format!("const {name}: u32 = {x}u;\n")),
+            ConstValue::Real(x) => s.push_str(&format!(
+                "const {name}: Real = {};\n",
+                real_literal(*x, precision)
+            )),
+        }
+    }
+    for (i, (name, b, access)) in kernel.bindings.iter().enumerate() {
+        let acc = match access {
+            Access::Read => "read",
+            Access::ReadWrite => "read_write",
+        };
+        let ty = match elems(*b) {
+            Elem::Real => "array<Real>",
+            Elem::U32 => "array<u32>",
+            Elem::Atomic => "array<atomic<u32>>",
+        };
+        s.push_str(&format!(
+            "@group(1) @binding({i}) var<storage, {acc}> {name}: {ty};\n"
+        ));
+    }
+    s.push_str(PRELUDE);
+    s.push_str(&kernel.source);
+    s
+}
+
+/// Assembles a kernel as the backend would, for a buffer-type lookup given by the caller
+/// (tests of physics crates use [`offline_kernel_sources`] instead).
+pub fn assemble_source(kernel: &Kernel, precision: Precision, real_buffers: &[GpuBuffer]) -> String {
+    assemble(kernel, precision, &|b| {
+        if real_buffers.contains(&b) {
+            Elem::Real
+        } else {
+            Elem::U32
+        }
+    })
+}
+
+/// Parses and validates a WGSL module with naga (with f64 support), as wgpu would;
+/// returns the diagnostic with source context on failure.
+pub fn validate_wgsl(source: &str) -> Result<(), String> {
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
+    let mut v = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::FLOAT64,
+    );
+    v.validate(&module)
+        .map(|_| ())
+        .map_err(|e| e.emit_to_string(source))
+}
+
+impl Program {
+    pub(crate) fn elem_of(&self, b: GpuBuffer) -> Elem {
+        self.buffers[b.0].elem
+    }
+}
+
+/// Builds the GPU program of `physics` on `mesh` without a device and returns every
+/// assembled kernel as `(label, WGSL)`, built-in kernels included: what a unit test
+/// feeds to [`validate_wgsl`]. Errors are those the simulation build would report.
+pub fn offline_kernel_sources<D: Dim, B: crate::Backend>(
+    mesh: &Mesh<D>,
+    physics: Vec<Box<dyn crate::Physics<D, B>>>,
+    precision: Precision,
+) -> Result<Vec<(String, String)>, ComputeError> {
+    let mut physics = physics;
+    let layout = crate::simulation::prepare_layout(mesh, &mut physics)?;
+    let program =
+        crate::gpu::run::build_program(mesh, &mut physics, &layout.fields, &layout, precision)?;
+    let mut out = Vec::new();
+    for (_, k) in &program.kernels {
+        out.push((
+            k.label.clone(),
+            assemble(k, precision, &|b| program.elem_of(b)),
+        ));
+    }
+    for k in crate::gpu::run::builtin_kernels::<D>(mesh.n_nodes(), layout.n_slots) {
+        let k = k.const_real("RUNAWAY2", 1.0);
+        out.push((
+            k.label.clone(),
+            assemble(&k, precision, &|b| program.elem_of(b)),
+        ));
+    }
+    Ok(out)
+}
