@@ -86,7 +86,6 @@ impl CpuBackend {
             threads,
         })
     }
-
 }
 
 impl Backend for CpuBackend {

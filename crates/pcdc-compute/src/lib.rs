@@ -26,9 +26,9 @@ mod statics;
 mod table;
 
 pub use backend::{Backend, BackendKind, CpuBackend};
-pub use gpu::{BackendChoice, Precision, WgpuBackend};
 pub use error::ComputeError;
 pub use field::{names, FieldId, FieldSpec, FieldStore, Location};
+pub use gpu::{BackendChoice, Precision, WgpuBackend};
 pub use history::{History, Probe};
 pub use physics::{
     DofConstraint, ForceContext, InitContext, Kinematics, Physics, SlotBlock, StableStep,

@@ -12,8 +12,8 @@ use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::physics::{ForceContext, InitContext, Kinematics, VelocityContext};
 use crate::gpu::GpuRun;
+use crate::physics::{ForceContext, InitContext, Kinematics, VelocityContext};
 use crate::{Backend, ComputeError, CpuBackend, FieldStore, Physics, StableStep};
 
 /// Default safety factor applied to the critical time step.
@@ -372,7 +372,10 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
 
     /// Labels of the GPU kernels in dispatch order (empty on the CPU backend).
     pub fn gpu_kernels(&self) -> Vec<String> {
-        self.gpu.as_ref().map(|g| g.kernel_labels()).unwrap_or_default()
+        self.gpu
+            .as_ref()
+            .map(|g| g.kernel_labels())
+            .unwrap_or_default()
     }
 
     /// Evaluates every physics' forces at the current state without advancing, and
@@ -530,7 +533,13 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
     }
 
     /// The divergence error for node `n` at `step` (time `time`).
-    pub(crate) fn divergence(&self, step: u64, time: f64, n: usize, nonfinite: bool) -> ComputeError {
+    pub(crate) fn divergence(
+        &self,
+        step: u64,
+        time: f64,
+        n: usize,
+        nonfinite: bool,
+    ) -> ComputeError {
         let hint = match &self.limit {
             Some(l) => format!(
                 "time step {:e} s (limit set by {} of {}); check that the time step is not above the stable one, that penalties are not extreme, and that loads and boundary conditions are sensible",

@@ -56,4 +56,4 @@ pub use actions::{reset_displacement, reset_element_state, reset_velocity, set_v
 pub use boundary::{Boundary, Components, Constraint, FaceStress, ACCEL_VELOCITY};
 pub use error::MechError;
 pub use mechanics::Mechanics;
-pub use model::{double_dot, ConstitutiveModel, LinearElastic, Sym6};
+pub use model::{double_dot, ConstitutiveModel, LinearElastic, Sym6, WgslModel};

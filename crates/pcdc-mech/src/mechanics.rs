@@ -10,8 +10,9 @@
 
 use std::sync::Arc;
 
+use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase};
 use pcdc_compute::{
-    names, ComputeError, Backend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
+    names, Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
     Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
@@ -547,10 +548,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
         })
     }
 
-    fn compute_forces(
-        &self,
-        ctx: &mut ForceContext<'_, D, B>,
-    ) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
         let ids = self.ids();
         let (d, npe, nsym) = (D::D, D::NODES_PER_ELEM, D::NSYM);
         let nx = if d == 2 { 1 } else { 9 };
@@ -592,6 +590,108 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
                 });
         });
         Ok(())
+    }
+
+    fn gpu_setup(&mut self, setup: &mut GpuSetup<'_, D>) -> Result<(), ComputeError> {
+        let (d, ne) = (D::D, self.material.len());
+        // One WGSL function per distinct model code; parameters per material.
+        let mut keys: Vec<String> = Vec::new();
+        let mut functions = String::new();
+        let mut mat_info = Vec::with_capacity(2 * self.models.len());
+        let mut params = Vec::new();
+        for m in &self.models {
+            let w = m.wgsl().ok_or_else(|| ComputeError::NoGpuKernel {
+                physics: "mechanics".into(),
+                reason: format!(
+                    "constitutive model '{}' has no WGSL body (implement ConstitutiveModel::wgsl)",
+                    m.name()
+                ),
+            })?;
+            let kind = match keys.iter().position(|k| *k == w.key) {
+                Some(k) => k,
+                None => {
+                    keys.push(w.key.clone());
+                    functions.push_str(&format!(
+                        "// model '{}'\nfn model_{}(strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, p: u32) -> Sym {{\n{}\n}}\n",
+                        w.key,
+                        keys.len() - 1,
+                        w.body
+                    ));
+                    keys.len() - 1
+                }
+            };
+            mat_info.extend([kind as u32, params.len() as u32]);
+            params.extend_from_slice(&w.params);
+        }
+        let mut dispatch = String::from(
+            "fn call_model(kind: u32, strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, p: u32) -> Sym {\n    var out = stress;\n    switch kind {\n",
+        );
+        for k in 0..keys.len() {
+            dispatch.push_str(&format!(
+                "        case {k}u: {{ out = model_{k}(strain, dstrain, stress, state, p); }}\n"
+            ));
+        }
+        dispatch.push_str("        default: {}\n    }\n    return out;\n}\n");
+        if params.is_empty() {
+            params.push(0.0);
+        }
+        // Per element: D_m⁻¹ (row-major), V₀, viscous coefficient D_f C (eq. 18-19).
+        let stride = d * d + 2;
+        let mut geo = Vec::with_capacity(ne * stride);
+        for e in 0..ne {
+            geo.extend_from_slice(&self.geo.dm_inv[e * d * d..(e + 1) * d * d]);
+            geo.push(self.geo.volume[e]);
+            geo.push(self.viscous_coefficient(e));
+        }
+        let conn = setup.upload("connectivity", GpuData::U32(setup.mesh.elements().to_vec()));
+        let geo = setup.upload("element geometry", GpuData::Real(geo));
+        let material = setup.upload(
+            "element material",
+            GpuData::U32(self.material.iter().map(|&m| m as u32).collect()),
+        );
+        let mat_info = setup.upload("material kinds", GpuData::U32(mat_info));
+        let mat_params = setup.upload("material parameters", GpuData::Real(params));
+        let ns = self.n_state.max(1);
+        let template = if d == 2 {
+            include_str!("shaders/element_2d.wgsl")
+        } else {
+            include_str!("shaders/element_3d.wgsl")
+        };
+        let source = format!(
+            "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{functions}{dispatch}{template}"
+        );
+        let polar_tol = match setup.precision() {
+            pcdc_compute::Precision::F64 => 1e-15,
+            pcdc_compute::Precision::F32 => 1e-6,
+        };
+        let extra = if d == 2 {
+            ("stress_zz", setup.field(names::STRESS_ZZ)?)
+        } else {
+            ("rotation", setup.field(names::ROTATION)?)
+        };
+        let kernel = Kernel::new(format!("mechanics {}", D::NAME), source, ne)
+            .const_u32("SLOT_FIRST", setup.slot_first())
+            .const_u32("NSTATE", ns as u32)
+            .const_u32("GEO", stride as u32)
+            .const_real("POLAR_TOL", polar_tol)
+            .bind("coords", setup.coords(), Access::Read)
+            .bind("disp", setup.displacement(), Access::Read)
+            .bind("vel", setup.velocity(), Access::Read)
+            .bind("conn", conn, Access::Read)
+            .bind("geo", geo, Access::Read)
+            .bind("material", material, Access::Read)
+            .bind("mat_info", mat_info, Access::Read)
+            .bind("mat_params", mat_params, Access::Read)
+            .bind("stress", setup.field(names::STRESS)?, Access::ReadWrite)
+            .bind("strain", setup.field(names::STRAIN)?, Access::ReadWrite)
+            .bind(extra.0, extra.1, Access::ReadWrite)
+            .bind(
+                "model_state",
+                setup.field(names::MODEL_STATE)?,
+                Access::ReadWrite,
+            )
+            .bind("slots", setup.slots(), Access::ReadWrite);
+        setup.kernel(Phase::Forces, kernel)
     }
 
     fn linear_stiffness(

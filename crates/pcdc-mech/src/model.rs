@@ -43,6 +43,33 @@ pub trait ConstitutiveModel: Send + Sync + std::fmt::Debug {
     fn linear_tangent(&self) -> Option<[[f64; 6]; 6]> {
         None
     }
+    /// The model for the GPU backend: a WGSL function body and its parameters (see
+    /// [`WgslModel`]). `None` (the default) means CPU only: building a GPU simulation
+    /// with such a model is an error that names it.
+    fn wgsl(&self) -> Option<WgslModel> {
+        None
+    }
+}
+
+/// A constitutive model's GPU code, spliced into the element kernel template.
+///
+/// `body` is the body of
+/// `fn (strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, p: u32) -> Sym`
+/// where `Sym = array<Real, 6>` holds xx, yy, zz, xy, yz, xz (tensor shear strains, as
+/// on the CPU), `stress` is σ(t), the function returns σ(t+Δt), `(*state)[k]` are the
+/// history variables and `param(p, k)` reads `params[k]`. `Real` is `f64` or `f32` by
+/// precision: write literals without suffix (`0.5`, not `0.5f`) and keep to + − × ÷,
+/// `sqrt`, `abs`, `min`, `max`, `select` (drivers may lack f64 `exp`/`pow`/`sin`). To match
+/// the CPU to rounding, repeat the CPU's operations in the same order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WgslModel {
+    /// Identifies the code: models with equal keys must have equal bodies (they share one
+    /// WGSL function and differ only in parameters).
+    pub key: String,
+    /// The WGSL function body.
+    pub body: String,
+    /// Parameters read with `param(p, k)`.
+    pub params: Vec<f64>,
 }
 
 /// Isotropic linear elasticity (manual eq. 20-24), updated incrementally
@@ -181,6 +208,13 @@ impl ConstitutiveModel for LinearElastic {
         for k in 0..6 {
             stress[k] += ds[k];
         }
+    }
+    fn wgsl(&self) -> Option<WgslModel> {
+        Some(WgslModel {
+            key: "linear_elastic".into(),
+            body: include_str!("shaders/linear_elastic.wgsl").into(),
+            params: vec![self.lambda(), self.shear()],
+        })
     }
     fn linear_tangent(&self) -> Option<[[f64; 6]; 6]> {
         let (l, m) = (self.lambda(), self.shear());

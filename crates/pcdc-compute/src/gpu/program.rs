@@ -279,14 +279,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 pub(crate) const PARAM_HEADER: usize = 9;
 
 fn real_literal(v: f64, p: Precision) -> String {
-    let v = if p == Precision::F32 { v as f32 as f64 } else { v };
+    let v = if p == Precision::F32 {
+        v as f32 as f64
+    } else {
+        v
+    };
     if v.is_finite() {
         let s = format!("{v:.17e}");
         format!("Real({s})")
     } else if v > 0.0 {
-        "Real(1e300)".into()
+        "REAL_MAX".into()
     } else {
-        "Real(-1e300)".into()
+        "(-REAL_MAX)".into()
     }
 }
 
@@ -304,6 +308,12 @@ pub(crate) fn assemble(
         Precision::F32 => "1.1920929e-7",
     };
     s.push_str(&format!("const REAL_EPS: Real = Real({eps});\n"));
+    // Largest finite magnitude we test against (NaN fails every comparison).
+    let max = match precision {
+        Precision::F64 => "1.0e300",
+        Precision::F32 => "3.0e38",
+    };
+    s.push_str(&format!("const REAL_MAX: Real = Real({max});\n"));
     s.push_str(&format!("const COUNT: u32 = {}u;\n", kernel.count));
     s.push_str(&format!("const PARAM_HEADER: u32 = {PARAM_HEADER}u;\n"));
     for (name, v) in &kernel.constants {
@@ -336,7 +346,11 @@ pub(crate) fn assemble(
 
 /// Assembles a kernel as the backend would, for a buffer-type lookup given by the caller
 /// (tests of physics crates use [`offline_kernel_sources`] instead).
-pub fn assemble_source(kernel: &Kernel, precision: Precision, real_buffers: &[GpuBuffer]) -> String {
+pub fn assemble_source(
+    kernel: &Kernel,
+    precision: Precision,
+    real_buffers: &[GpuBuffer],
+) -> String {
     assemble(kernel, precision, &|b| {
         if real_buffers.contains(&b) {
             Elem::Real

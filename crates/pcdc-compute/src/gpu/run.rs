@@ -2,9 +2,7 @@
 
 use pcdc_mesh::{Dim, Mesh};
 
-use super::program::{
-    assemble, builtin, validate_wgsl, BufferDecl, Elem, Program, PARAM_HEADER,
-};
+use super::program::{assemble, builtin, validate_wgsl, BufferDecl, Elem, Program, PARAM_HEADER};
 use super::{Access, GpuBuffer, GpuData, GpuSetup, Kernel, Phase, Precision, WgpuBackend};
 use crate::{Backend, ComputeError, FieldStore, Physics, Simulation};
 
@@ -64,15 +62,30 @@ pub(crate) fn build_program<D: Dim, B: Backend>(
 ) -> Result<Program, ComputeError> {
     let nd = mesh.n_nodes() * D::D;
     let mut buffers = vec![
-        decl("coords", Elem::Real, nd, Some(GpuData::Real(mesh.coords().to_vec()))),
+        decl(
+            "coords",
+            Elem::Real,
+            nd,
+            Some(GpuData::Real(mesh.coords().to_vec())),
+        ),
         decl("displacement", Elem::Real, nd, None),
         decl("velocity", Elem::Real, nd, None),
         decl("mass", Elem::Real, mesh.n_nodes(), None),
         decl("mass_phys", Elem::Real, mesh.n_nodes(), None),
         decl("force", Elem::Real, nd, None),
         decl("slots", Elem::Real, layout.n_slots * D::D, None),
-        decl("gather_ptr", Elem::U32, layout.gather_ptr.len(), Some(GpuData::U32(layout.gather_ptr.clone()))),
-        decl("gather_idx", Elem::U32, layout.gather_idx.len(), Some(GpuData::U32(layout.gather_idx.clone()))),
+        decl(
+            "gather_ptr",
+            Elem::U32,
+            layout.gather_ptr.len(),
+            Some(GpuData::U32(layout.gather_ptr.clone())),
+        ),
+        decl(
+            "gather_idx",
+            Elem::U32,
+            layout.gather_idx.len(),
+            Some(GpuData::U32(layout.gather_idx.clone())),
+        ),
         decl("status", Elem::Atomic, 4, None),
         decl("gross", Elem::Real, nd, None),
     ];
@@ -80,7 +93,12 @@ pub(crate) fn build_program<D: Dim, B: Backend>(
     let mut field_buffers = Vec::new();
     for spec in fields.specs() {
         let id = fields.id(&spec.name)?;
-        buffers.push(decl(&format!("field {}", spec.name), Elem::Real, fields.get(id).len(), None));
+        buffers.push(decl(
+            &format!("field {}", spec.name),
+            Elem::Real,
+            fields.get(id).len(),
+            None,
+        ));
         field_buffers.push(buffers.len() - 1);
     }
     let mut program = Program {
@@ -187,7 +205,8 @@ impl GpuRun {
         let mut buffers = Vec::with_capacity(decls.len());
         for dcl in &decls {
             let size = ((dcl.len * eb(dcl.elem)).max(16) as u64).next_multiple_of(16);
-            if size > limits.max_storage_buffer_binding_size as u64 || size > limits.max_buffer_size {
+            if size > limits.max_storage_buffer_binding_size as u64 || size > limits.max_buffer_size
+            {
                 return Err(ComputeError::Gpu(format!(
                     "buffer '{}' needs {size} bytes, above the device's storage-buffer limit ({} bytes)",
                     dcl.label, limits.max_storage_buffer_binding_size
@@ -202,9 +221,15 @@ impl GpuRun {
                 mapped_at_creation: false,
             });
             match &dcl.data {
-                Some(GpuData::Real(v)) => backend.queue().write_buffer(&buf, 0, &real_bytes(v, precision)),
+                Some(GpuData::Real(v)) => {
+                    backend
+                        .queue()
+                        .write_buffer(&buf, 0, &real_bytes(v, precision))
+                }
                 Some(GpuData::U32(v)) if !v.is_empty() => {
-                    backend.queue().write_buffer(&buf, 0, bytemuck::cast_slice(v))
+                    backend
+                        .queue()
+                        .write_buffer(&buf, 0, bytemuck::cast_slice(v))
                 }
                 _ => {}
             }
@@ -212,7 +237,8 @@ impl GpuRun {
         }
         // Step records: fixed head + signals, padded to the dynamic-offset alignment.
         let align = limits.min_storage_buffer_offset_alignment.max(16) as usize;
-        let record_bytes = ((PARAM_HEADER + signals.len()) * precision.bytes()).next_multiple_of(align);
+        let record_bytes =
+            ((PARAM_HEADER + signals.len()) * precision.bytes()).next_multiple_of(align);
         let record_reals = record_bytes / precision.bytes();
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("step records"),
@@ -392,9 +418,11 @@ impl GpuRun {
 
     fn write_reals(&self, buffer: usize, v: &[f64]) {
         if !v.is_empty() {
-            self.backend
-                .queue()
-                .write_buffer(&self.buffers[buffer], 0, &real_bytes(v, self.precision));
+            self.backend.queue().write_buffer(
+                &self.buffers[buffer],
+                0,
+                &real_bytes(v, self.precision),
+            );
         }
     }
 
@@ -414,7 +442,13 @@ impl GpuRun {
         );
     }
 
-    fn record<D: Dim, B: Backend>(&self, sim: &Simulation<D, B>, t: f64, step: u64, out: &mut Vec<f64>) {
+    fn record<D: Dim, B: Backend>(
+        &self,
+        sim: &Simulation<D, B>,
+        t: f64,
+        step: u64,
+        out: &mut Vec<f64>,
+    ) {
         let start = out.len();
         out.resize(start + self.record_reals, 0.0);
         let r = &mut out[start..];
@@ -470,20 +504,28 @@ impl GpuRun {
                 self.record(sim, tt, step + j as u64 + 1, &mut records);
                 tt += sim.dt;
             }
-            self.backend
-                .queue()
-                .write_buffer(&self.params, 0, &real_bytes(&records, self.precision));
-            let mut enc = self
-                .backend
-                .device()
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("steps") });
+            self.backend.queue().write_buffer(
+                &self.params,
+                0,
+                &real_bytes(&records, self.precision),
+            );
+            let mut enc =
+                self.backend
+                    .device()
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("steps"),
+                    });
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("steps"),
                     timestamp_writes: None,
                 });
                 for j in 0..k {
-                    pass.set_bind_group(0, &self.params_group, &[(j as u64 * self.record_bytes) as u32]);
+                    pass.set_bind_group(
+                        0,
+                        &self.params_group,
+                        &[(j as u64 * self.record_bytes) as u32],
+                    );
                     for p in &self.forces {
                         self.dispatch(&mut pass, p);
                     }
@@ -530,10 +572,12 @@ impl GpuRun {
         self.backend
             .queue()
             .write_buffer(&self.params, 0, &real_bytes(&records, self.precision));
-        let mut enc = self
-            .backend
-            .device()
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("forces") });
+        let mut enc =
+            self.backend
+                .device()
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("forces"),
+                });
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("forces"),
@@ -617,7 +661,13 @@ impl GpuRun {
                 gross_out = Some(g);
                 k = 5;
             }
-            let names: Vec<String> = sim.state.fields.specs().iter().map(|s| s.name.clone()).collect();
+            let names: Vec<String> = sim
+                .state
+                .fields
+                .specs()
+                .iter()
+                .map(|s| s.name.clone())
+                .collect();
             for name in names {
                 let id = sim.state.fields.id(&name)?;
                 let dst = sim.state.fields.get_mut(id);

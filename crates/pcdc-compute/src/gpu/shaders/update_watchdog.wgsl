@@ -2,8 +2,6 @@
 // A non-finite value or a displacement beyond the runaway limit records the first bad
 // step in status[0] and, for that step, the smallest code node*2 + (0 non-finite,
 // 1 runaway) in status[1]. Integer atomics only; no float atomics.
-const BIG: Real = Real(1.0e300);
-
 fn kernel(n: u32) {
     let dt = p_dt();
     var u2 = Real(0.0);
@@ -15,7 +13,7 @@ fn kernel(n: u32) {
         disp[i] = uk;
         u2 = u2 + uk * uk;
         // NaN fails every comparison, so this also catches NaN.
-        finite = finite && abs(uk) <= BIG && abs(vk) <= BIG;
+        finite = finite && abs(uk) <= REAL_MAX && abs(vk) <= REAL_MAX;
     }
     var code = 0xffffffffu;
     if !finite {
