@@ -787,3 +787,79 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
             .sum()
     }
 }
+
+#[cfg(test)]
+mod gpu_tests {
+    use super::*;
+    use crate::LinearElastic;
+    use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
+    use pcdc_compute::{CpuBackend, Precision};
+    use pcdc_mesh::builders;
+
+    /// A model with two history variables and no WGSL body (CPU only).
+    #[derive(Debug)]
+    struct CpuOnly;
+    impl ConstitutiveModel for CpuOnly {
+        fn name(&self) -> &str {
+            "cpu-only"
+        }
+        fn density(&self) -> f64 {
+            2000.0
+        }
+        fn young(&self) -> f64 {
+            1e9
+        }
+        fn wave_modulus(&self) -> f64 {
+            1e9
+        }
+        fn damp_factor(&self) -> f64 {
+            0.0
+        }
+        fn n_state(&self) -> usize {
+            2
+        }
+        fn update(&self, _: &Sym6, _: &Sym6, _: &mut Sym6, _: &mut [f64]) {}
+    }
+
+    fn mech(e: f64) -> Mechanics {
+        Mechanics::new()
+            .material(Range::All, LinearElastic::new(e, 0.25, 2500.0).unwrap())
+            .material(
+                Range::Ball {
+                    center: [0.0; 3],
+                    radius: 0.6,
+                },
+                LinearElastic::new(2.0 * e, 0.2, 2600.0).unwrap(),
+            )
+    }
+
+    #[test]
+    fn element_kernels_validate_with_naga() {
+        let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
+        let m3 = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
+        for p in [Precision::F64, Precision::F32] {
+            let s2 = offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(mech(1e9))], p)
+                .unwrap();
+            let s3 = offline_kernel_sources::<_, CpuBackend>(&m3, vec![Box::new(mech(1e9))], p)
+                .unwrap();
+            for (label, src) in s2.iter().chain(&s3) {
+                if let Err(e) = validate_wgsl(src) {
+                    panic!("{label} ({}) does not validate:\n{e}", p.name());
+                }
+            }
+            // Two materials of one model share one WGSL function.
+            let (_, src) = &s2[0];
+            assert_eq!(src.matches("fn model_").count(), 1);
+        }
+    }
+
+    #[test]
+    fn model_without_wgsl_is_a_build_error_naming_it() {
+        let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        let mech = Mechanics::new().material(Range::All, CpuOnly);
+        let err = offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(mech)], Precision::F64)
+            .unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.contains("cpu-only") && msg.contains("WGSL"), "{msg}");
+    }
+}

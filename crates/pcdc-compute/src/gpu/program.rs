@@ -407,3 +407,46 @@ pub fn offline_kernel_sources<D: Dim, B: crate::Backend>(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::CpuBackend;
+    use pcdc_mesh::builders;
+
+    #[test]
+    fn builtin_kernels_validate_with_naga() {
+        let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        let m3 = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
+        for p in [Precision::F64, Precision::F32] {
+            let s2 = offline_kernel_sources::<_, CpuBackend>(&m2, Vec::new(), p).unwrap();
+            let s3 = offline_kernel_sources::<_, CpuBackend>(&m3, Vec::new(), p).unwrap();
+            assert_eq!(s2.len(), 3);
+            for (label, src) in s2.iter().chain(&s3) {
+                assert!(src.starts_with(&format!("alias Real = {};", p.name())));
+                if let Err(e) = validate_wgsl(src) {
+                    panic!("{label} ({}) does not validate:\n{e}", p.name());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn invalid_wgsl_is_reported_with_context() {
+        let err = validate_wgsl("fn kernel(i: u32) { let x: Real = 1.0; }").unwrap_err();
+        assert!(err.contains("Real"), "{err}");
+    }
+
+    #[test]
+    fn real_constants_keep_full_precision() {
+        let k = Kernel::new("k", "fn kernel(i: u32) {}", 1).const_real("X", 0.1);
+        let src = assemble_source(&k, Precision::F64, &[]);
+        let line = src.lines().find(|l| l.starts_with("const X")).unwrap();
+        let v: f64 = line
+            .trim_start_matches("const X: Real = Real(")
+            .trim_end_matches(");")
+            .parse()
+            .unwrap();
+        assert_eq!(v, 0.1);
+    }
+}
