@@ -119,3 +119,62 @@ fn tet4_f32_error_is_small() {
     let mesh = builders::cuboid([0.0; 3], [0.1, 0.05, 0.05], 0.025).unwrap();
     parity(mesh, Precision::F32, 1e-3);
 }
+
+/// A time step far above the stable one: both backends stop with the same step and node.
+#[test]
+fn watchdog_names_the_same_step_and_node() {
+    let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
+        return;
+    };
+    fn diverge<B: Backend>(backend: B) -> (u64, String) {
+        let mesh = builders::rectangle(0.0, 0.0, 0.2, 0.1, 0.02).unwrap();
+        let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
+        let mut sim = Simulation::builder(mesh, backend)
+            .physics(Mechanics::new().material(Range::All, rock))
+            .time_step(5e-6)
+            .runaway_displacement(1.0)
+            .build()
+            .unwrap();
+        sim.state.u[7] = 1e-6;
+        match sim.run(2000) {
+            Err(pcdc_compute::ComputeError::Diverged { step, entity, .. }) => (step, entity),
+            other => panic!("expected divergence, got {other:?}"),
+        }
+    }
+    let cpu = diverge(CpuBackend::new(1).unwrap());
+    let gpu = diverge(gpu);
+    println!("cpu stops at {cpu:?}, gpu at {gpu:?}");
+    assert_eq!(cpu, gpu);
+}
+
+/// Restore-and-continue on the GPU equals the uninterrupted GPU run bit for bit.
+#[test]
+fn gpu_restore_and_continue_is_exact() {
+    let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
+        return;
+    };
+    let mesh = builders::cuboid([0.0; 3], [0.1, 0.05, 0.05], 0.025).unwrap();
+    let build = || {
+        let rock = LinearElastic::new(30e9, 0.25, 2600.0)
+            .unwrap()
+            .with_damping(0.2)
+            .unwrap();
+        let mut sim = Simulation::builder(mesh.clone(), gpu.clone())
+            .physics(Mechanics::new().material(Range::All, rock))
+            .build()
+            .unwrap();
+        for (i, v) in sim.state.v.iter_mut().enumerate() {
+            *v = 0.1 * noise(i);
+        }
+        sim
+    };
+    let mut a = build();
+    a.run(100).unwrap();
+    let snap = a.snapshot_bytes().unwrap();
+    a.run(150).unwrap();
+    let mut b = build();
+    b.restore_bytes(&snap).unwrap();
+    b.run(150).unwrap();
+    assert_eq!(a.state.u, b.state.u);
+    assert_eq!(a.field("stress").unwrap(), b.field("stress").unwrap());
+}
