@@ -15,8 +15,8 @@
 use std::sync::Arc;
 
 use pcdc_compute::{
-    ComputeError, Backend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
-    Kinematics, Location, Physics, StableStep,
+    Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext, Kinematics,
+    Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
@@ -365,10 +365,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
         })
     }
 
-    fn compute_forces(
-        &self,
-        ctx: &mut ForceContext<'_, D, B>,
-    ) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
         let [sid, did, bid] = self.ids.expect("init ran");
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let stride = self.state_stride();

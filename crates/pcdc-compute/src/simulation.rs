@@ -370,6 +370,14 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
         Ok(())
     }
 
+    /// Device-memory bytes one step streams on the GPU backend (every bound buffer read
+    /// once, read-write ones written once more; `None` on the CPU backend). Divide by the
+    /// element count and multiply by the achieved element-steps/s to compare with the
+    /// device's memory bandwidth.
+    pub fn gpu_bytes_per_step(&self) -> Option<u64> {
+        self.gpu.as_ref().map(|g| g.bytes_per_step())
+    }
+
     /// Labels of the GPU kernels in dispatch order (empty on the CPU backend).
     pub fn gpu_kernels(&self) -> Vec<String> {
         self.gpu

@@ -17,8 +17,8 @@
 use std::sync::Mutex;
 
 use pcdc_compute::{
-    ComputeError, Backend, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
-    Kinematics, Location, Physics, StableStep,
+    Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext, Kinematics,
+    Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;
@@ -356,10 +356,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         })
     }
 
-    fn compute_forces(
-        &self,
-        ctx: &mut ForceContext<'_, D, B>,
-    ) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
         let rid = self.reference.expect("init ran");
         let kin = &ctx.kin;
         let reference = ctx.fields.get_mut(rid);

@@ -838,10 +838,10 @@ mod gpu_tests {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
         let m3 = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
         for p in [Precision::F64, Precision::F32] {
-            let s2 = offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(mech(1e9))], p)
-                .unwrap();
-            let s3 = offline_kernel_sources::<_, CpuBackend>(&m3, vec![Box::new(mech(1e9))], p)
-                .unwrap();
+            let s2 =
+                offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(mech(1e9))], p).unwrap();
+            let s3 =
+                offline_kernel_sources::<_, CpuBackend>(&m3, vec![Box::new(mech(1e9))], p).unwrap();
             for (label, src) in s2.iter().chain(&s3) {
                 if let Err(e) = validate_wgsl(src) {
                     panic!("{label} ({}) does not validate:\n{e}", p.name());
@@ -857,8 +857,9 @@ mod gpu_tests {
     fn model_without_wgsl_is_a_build_error_naming_it() {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
         let mech = Mechanics::new().material(Range::All, CpuOnly);
-        let err = offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(mech)], Precision::F64)
-            .unwrap_err();
+        let err =
+            offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(mech)], Precision::F64)
+                .unwrap_err();
         let msg = err.to_string();
         assert!(msg.contains("cpu-only") && msg.contains("WGSL"), "{msg}");
     }

@@ -125,6 +125,9 @@ pub(crate) fn build_program<D: Dim, B: Backend>(
 
 struct Pipeline {
     label: String,
+    /// Bytes streamed per dispatch if every bound buffer is read once (written once more
+    /// when read-write).
+    bytes: u64,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
     count: u32,
@@ -341,7 +344,20 @@ impl GpuRun {
             if let Some(e) = pollster::block_on(scope.pop()) {
                 return Err(ComputeError::Gpu(format!("kernel '{}': {e}", k.label)));
             }
+            let bytes = k
+                .bindings
+                .iter()
+                .map(|(_, b, acc)| {
+                    let size = (decls[b.0].len * eb(decls[b.0].elem)) as u64;
+                    if *acc == Access::ReadWrite {
+                        2 * size
+                    } else {
+                        size
+                    }
+                })
+                .sum();
             Ok(Pipeline {
+                bytes,
                 label: k.label.clone(),
                 pipeline,
                 bind_group,
@@ -682,6 +698,19 @@ impl GpuRun {
 }
 
 impl GpuRun {
+    /// Bytes one explicit step streams through device memory if every bound buffer is read
+    /// once and read-write buffers are written once more: the traffic floor to compare
+    /// an achieved step rate with memory bandwidth.
+    pub(crate) fn bytes_per_step(&self) -> u64 {
+        self.forces
+            .iter()
+            .chain(std::iter::once(&self.gather_integrate))
+            .chain(&self.kinematics)
+            .chain(std::iter::once(&self.update))
+            .map(|p| p.bytes)
+            .sum()
+    }
+
     /// Labels of the compiled kernels in dispatch order (for reports).
     pub(crate) fn kernel_labels(&self) -> Vec<String> {
         self.forces
