@@ -6,9 +6,16 @@
 //! Sign convention: tension positive. A face stress applies the traction `t = σ n` on
 //! the face's current outward normal `n`, with `σ = diag(s_xx, s_yy, s_zz) + s_n I`; a
 //! compressive far-field stress or a pressure is therefore negative.
+//!
+//! On the GPU backend every item is one kernel (`src/shaders/boundary_*.wgsl`): forces
+//! (node force, face stress) in the force phase, kinematic items (velocity,
+//! acceleration, constraint) after the velocity update, in the order the items were
+//! added. Time tables are evaluated on the host once per step as signals, at exactly the
+//! times the CPU path uses, so f64 results match the CPU to rounding.
 
+use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase};
 use pcdc_compute::{
-    ComputeError, Backend, DofConstraint, FieldId, FieldSpec, FieldStore, ForceContext,
+    Backend, ComputeError, DofConstraint, FieldId, FieldSpec, FieldStore, ForceContext,
     InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
@@ -192,6 +199,37 @@ impl Boundary {
     }
 }
 
+const NODE_FORCE_WGSL: &str = include_str!("shaders/boundary_node_force.wgsl");
+const FACE_STRESS_WGSL: &str = include_str!("shaders/boundary_face_stress.wgsl");
+const VELOCITY_WGSL: &str = include_str!("shaders/boundary_velocity.wgsl");
+const ACCELERATION_WGSL: &str = include_str!("shaders/boundary_acceleration.wgsl");
+const CONSTRAINT_WGSL: &str = include_str!("shaders/boundary_constraint.wgsl");
+
+/// Registers one signal per component `k < D` (consecutive indices) and returns the
+/// first; `value(k)` gives component k's closure of `(t, dt)`, t the time at the start of
+/// the step.
+fn component_signals<D: Dim, F>(
+    setup: &mut GpuSetup<'_, D>,
+    mut value: impl FnMut(usize) -> F,
+) -> u32
+where
+    F: Fn(f64, f64) -> f64 + Send + Sync + 'static,
+{
+    let first = setup.signal(value(0));
+    for k in 1..D::D {
+        let s = setup.signal(value(k));
+        debug_assert_eq!(s, first + k as u32);
+    }
+    first
+}
+
+/// Bit k set when component k is prescribed.
+fn mask<D: Dim>(values: &Components) -> u32 {
+    (0..D::D)
+        .filter(|&k| values[k].is_some())
+        .fold(0, |m, k| m | (1 << k))
+}
+
 fn unit<D: Dim>(d: &[f64; 3]) -> [f64; 3] {
     let n = (0..D::D).map(|k| d[k] * d[k]).sum::<f64>().sqrt();
     let mut out = [0.0; 3];
@@ -271,10 +309,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
         Ok(())
     }
 
-    fn compute_forces(
-        &self,
-        ctx: &mut ForceContext<'_, D, B>,
-    ) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
         let d = D::D;
         let t = ctx.kin.time;
         for (it, r) in self.items.iter().zip(&self.resolved) {
@@ -378,6 +413,116 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
         }
     }
 
+    fn gpu_setup(&mut self, setup: &mut GpuSetup<'_, D>) -> Result<(), ComputeError> {
+        if self.resolved.len() != self.items.len() {
+            return Err(ComputeError::Gpu(
+                "mechanical boundary: GPU setup before init".to_string(),
+            ));
+        }
+        let d = D::D as u32;
+        let slot0 = setup.slot_first();
+        for (i, (it, r)) in self.items.iter().zip(&self.resolved).enumerate() {
+            let label = |what: &str| format!("boundary {i}: {what}");
+            match it {
+                Item::NodeForce { values, .. } => {
+                    let block = r.slots.expect("slots registered");
+                    // Forces at the start of the step, as `compute_forces` (kin.time).
+                    let sig = component_signals(setup, |k| {
+                        let v = values[k].clone();
+                        move |t: f64, _dt: f64| v.as_ref().map_or(0.0, |v| v.at(t))
+                    });
+                    let k = Kernel::new(label("node force"), NODE_FORCE_WGSL, block.len)
+                        .const_u32("D", d)
+                        .const_u32("SLOT0", slot0 + block.first as u32)
+                        .const_u32("SIG", sig)
+                        .bind("slots", setup.slots(), Access::ReadWrite);
+                    setup.kernel(Phase::Forces, k)?;
+                }
+                Item::FaceStress { stress, .. } => {
+                    let block = r.slots.expect("slots registered");
+                    let npf = D::NODES_PER_FACE;
+                    // Component c carries σ_cc + σ_n at the start of the step, summed in
+                    // f64 exactly as `compute_forces` does.
+                    let sig = component_signals(setup, |c| {
+                        let diag = [&stress.xx, &stress.yy, &stress.zz][c].clone();
+                        let normal = stress.normal.clone();
+                        move |t: f64, _dt: f64| {
+                            diag.as_ref().map_or(0.0, |v| v.at(t))
+                                + normal.as_ref().map_or(0.0, |v| v.at(t))
+                        }
+                    });
+                    let face_nodes: Vec<u32> = r
+                        .faces
+                        .iter()
+                        .flat_map(|&f| setup.mesh.face(f as usize).iter().copied())
+                        .collect();
+                    let faces = setup.upload(&label("face nodes"), GpuData::U32(face_nodes));
+                    let k = Kernel::new(label("face stress"), FACE_STRESS_WGSL, r.faces.len())
+                        .const_u32("D", d)
+                        .const_u32("NPF", npf as u32)
+                        .const_real("NPF_REAL", npf as f64)
+                        .const_u32("SLOT0", slot0 + block.first as u32)
+                        .const_u32("SIG", sig)
+                        .bind("coords", setup.coords(), Access::Read)
+                        .bind("disp", setup.displacement(), Access::Read)
+                        .bind("faces", faces, Access::Read)
+                        .bind("slots", setup.slots(), Access::ReadWrite);
+                    setup.kernel(Phase::Forces, k)?;
+                }
+                Item::Velocity { values, .. } => {
+                    // `apply_kinematics` evaluates at (t_end) - dt/2, t_end = t + dt.
+                    let sig = component_signals(setup, |k| {
+                        let v = values[k].clone();
+                        move |t: f64, dt: f64| v.as_ref().map_or(0.0, |v| v.at((t + dt) - 0.5 * dt))
+                    });
+                    let nodes = setup.upload(&label("nodes"), GpuData::U32(r.nodes.clone()));
+                    let k = Kernel::new(label("velocity"), VELOCITY_WGSL, r.nodes.len())
+                        .const_u32("D", d)
+                        .const_u32("MASK", mask::<D>(values))
+                        .const_u32("SIG", sig)
+                        .bind("nodes", nodes, Access::Read)
+                        .bind("vel", setup.velocity(), Access::ReadWrite);
+                    setup.kernel(Phase::Kinematics, k)?;
+                }
+                Item::Acceleration { values, .. } => {
+                    // Increment a(t_end - dt) dt, t_end = t + dt, as `apply_kinematics`.
+                    let sig = component_signals(setup, |k| {
+                        let a = values[k].clone();
+                        move |t: f64, dt: f64| a.as_ref().map_or(0.0, |a| a.at((t + dt) - dt) * dt)
+                    });
+                    let acc = setup.field(ACCEL_VELOCITY)?;
+                    let nodes = setup.upload(&label("nodes"), GpuData::U32(r.nodes.clone()));
+                    let k = Kernel::new(label("acceleration"), ACCELERATION_WGSL, r.nodes.len())
+                        .const_u32("D", d)
+                        .const_u32("MASK", mask::<D>(values))
+                        .const_u32("SIG", sig)
+                        .bind("nodes", nodes, Access::Read)
+                        .bind("vel", setup.velocity(), Access::ReadWrite)
+                        .bind("acc", acc, Access::ReadWrite);
+                    setup.kernel(Phase::Kinematics, k)?;
+                }
+                Item::Constraint { constraint, .. } => {
+                    let (kind, u) = match constraint {
+                        Constraint::Fixed => (0, [0.0; 3]),
+                        Constraint::Line(dir) => (1, unit::<D>(dir)),
+                        Constraint::Plane(nrm) => (2, unit::<D>(nrm)),
+                    };
+                    let nodes = setup.upload(&label("nodes"), GpuData::U32(r.nodes.clone()));
+                    let k = Kernel::new(label("constraint"), CONSTRAINT_WGSL, r.nodes.len())
+                        .const_u32("D", d)
+                        .const_u32("KIND", kind)
+                        .const_real("U0", u[0])
+                        .const_real("U1", u[1])
+                        .const_real("U2", u[2])
+                        .bind("nodes", nodes, Access::Read)
+                        .bind("vel", setup.velocity(), Access::ReadWrite);
+                    setup.kernel(Phase::Kinematics, k)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
     fn linear_stiffness(
         &self,
         _mesh: &Mesh<D>,
@@ -419,5 +564,79 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl, Precision};
+    use pcdc_compute::{CpuBackend, Table};
+    use pcdc_mesh::builders;
+
+    fn ramp() -> TimeValue {
+        Table::new("ramp", &[(0.0, 0.0), (1.0, 2.0)])
+            .unwrap()
+            .into()
+    }
+
+    /// A boundary with every kind of item (tables and constants, partial components).
+    fn every_item(sides: [&str; 4]) -> Boundary {
+        let [a, b, c, e] = sides.map(Range::group);
+        Boundary::new()
+            .velocity(a.clone(), [None, Some(ramp()), Some(0.5.into())])
+            .acceleration(b.clone(), [Some(ramp()), None, Some(1.0.into())])
+            .node_force(c.clone(), [Some(1.0.into()), Some(ramp()), None])
+            .face_stress(
+                e.clone(),
+                FaceStress {
+                    xx: Some(ramp()),
+                    yy: Some((-2.0).into()),
+                    zz: Some(3.0.into()),
+                    normal: Some(ramp()),
+                },
+            )
+            .fix(a)
+            .constraint(b, Constraint::Line([1.0, 1.0, 1.0]))
+            .constraint(c, Constraint::Plane([0.0, 2.0, 1.0]))
+            .face_stress(e, FaceStress::normal(-1.0))
+    }
+
+    fn check_sources<D: Dim>(mesh: &Mesh<D>, boundary: Boundary) {
+        for precision in [Precision::F64, Precision::F32] {
+            let physics: Vec<Box<dyn Physics<D, CpuBackend>>> = vec![Box::new(boundary.clone())];
+            let sources = offline_kernel_sources(mesh, physics, precision).unwrap();
+            let ours: Vec<&str> = sources
+                .iter()
+                .map(|(l, _)| l.as_str())
+                .filter(|l| l.starts_with("boundary"))
+                .collect();
+            assert_eq!(
+                ours,
+                [
+                    "boundary 0: velocity",
+                    "boundary 1: acceleration",
+                    "boundary 2: node force",
+                    "boundary 3: face stress",
+                    "boundary 4: constraint",
+                    "boundary 5: constraint",
+                    "boundary 6: constraint",
+                    "boundary 7: face stress",
+                ]
+            );
+            for (label, src) in &sources {
+                if let Err(e) = validate_wgsl(src) {
+                    panic!("{label} ({precision:?}) does not validate:\n{e}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn gpu_kernels_validate_with_naga_2d_and_3d() {
+        let m2 = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.25).unwrap();
+        check_sources(&m2, every_item(["top", "left", "right", "bottom"]));
+        let m3 = builders::cuboid([0.0; 3], [1.0, 0.5, 0.5], 0.5).unwrap();
+        check_sources(&m3, every_item(["zmax", "xmin", "xmax", "ymin"]));
     }
 }

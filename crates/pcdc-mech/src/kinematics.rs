@@ -44,6 +44,28 @@ pub fn polar_2d(f: &[f64; 4]) -> (f64, f64) {
     }
 }
 
+/// 2D polar decomposition of `F = I + H` given the displacement gradient `H` (row-major
+/// 2x2): returns `(cos θ, sin θ, cos θ − 1)`, the last without cancellation
+/// (`cos θ − 1 = −s² / (r (c + r))` for `c ≥ 0`, with `c = 2 + H₀₀ + H₁₁`, `s = H₁₀ − H₀₁`, `r = √(c² + s²)`).
+#[inline]
+pub fn polar_2d_h(h: &[f64; 4]) -> (f64, f64, f64) {
+    let c = 2.0 + (h[0] + h[3]);
+    let s = h[2] - h[1];
+    let r = (c * c + s * s).sqrt();
+    if r > 0.0 {
+        let co = c / r;
+        // The cancellation-free form needs c ≥ 0; beyond a quarter turn co − 1 has none.
+        let cm1 = if c >= 0.0 {
+            -(s * s) / (r * (c + r))
+        } else {
+            co - 1.0
+        };
+        (co, s / r, cm1)
+    } else {
+        (1.0, 0.0, 0.0)
+    }
+}
+
 /// Determinant of a row-major 3x3 matrix.
 #[inline]
 pub fn det3(a: &[f64; 9]) -> f64 {
@@ -147,6 +169,10 @@ mod tests {
             let f = [ct * u[0] - st * u[2], ct * u[1] - st * u[3], st * u[0] + ct * u[2], st * u[1] + ct * u[3]];
             let (cc, ss) = polar_2d(&f);
             prop_assert!((cc - ct).abs() < 1e-12 && (ss - st).abs() < 1e-12);
+            let h = [f[0] - 1.0, f[1], f[2], f[3] - 1.0];
+            let (ch, sh, cm1) = polar_2d_h(&h);
+            prop_assert!((ch - ct).abs() < 1e-12 && (sh - st).abs() < 1e-12);
+            prop_assert!((cm1 - (ct - 1.0)).abs() < 1e-12);
         }
     }
 }

@@ -18,7 +18,7 @@ use pcdc_compute::{
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
-use crate::kinematics::{deformation_gradient_2d, dm_inv_2d, polar_2d, polar_3d};
+use crate::kinematics::{dm_inv_2d, polar_2d_h, polar_3d};
 use crate::model::{double_dot, ConstitutiveModel, Sym6};
 use crate::MechError;
 
@@ -199,7 +199,6 @@ fn geometry<D: Dim>(mesh: &Mesh<D>) -> ElementGeometry {
 /// Inputs shared by all elements of one force evaluation.
 struct StepInputs<'a> {
     conn: &'a [u32],
-    x0: &'a [f64],
     u: &'a [f64],
     v: &'a [f64],
     damping: bool,
@@ -220,17 +219,30 @@ impl Mechanics {
     ) {
         let c = &inp.conn[3 * e..3 * e + 3];
         let (n0, n1, n2) = (c[0] as usize * 2, c[1] as usize * 2, c[2] as usize * 2);
-        let p = |n: usize, k: usize| inp.x0[n + k] + inp.u[n + k];
-        let x = [p(n0, 0), p(n0, 1), p(n1, 0), p(n1, 1), p(n2, 0), p(n2, 1)];
         let m = &self.geo.dm_inv[4 * e..4 * e + 4];
-        let f = deformation_gradient_2d(&x, m);
-        let (co, si) = polar_2d(&f);
-        // U = Rᵀ F
-        let u00 = co * f[0] + si * f[2];
-        let u01 = co * f[1] + si * f[3];
-        let u10 = -si * f[0] + co * f[2];
-        let u11 = -si * f[1] + co * f[3];
-        let eps: Sym6 = [u00 - 1.0, u11 - 1.0, 0.0, 0.5 * (u01 + u10), 0.0, 0.0];
+        // Displacement gradient H = ∂u/∂X = [u₁ − u₀, u₂ − u₀] D_m⁻¹ and F = I + H: built
+        // from displacement differences, not from current positions, so that small
+        // strains keep their digits (x = X + u would round u to the ulp of X).
+        let du = |n: usize, k: usize| inp.u[n + k] - inp.u[n0 + k];
+        let (d0, d1, d2, d3) = (du(n1, 0), du(n2, 0), du(n1, 1), du(n2, 1));
+        let h = [
+            d0 * m[0] + d1 * m[2],
+            d0 * m[1] + d1 * m[3],
+            d2 * m[0] + d3 * m[2],
+            d2 * m[1] + d3 * m[3],
+        ];
+        let (co, si, cm1) = polar_2d_h(&h);
+        // ε = U − I with U = Rᵀ(I + H), written without the cancellation of U − I:
+        // U₀₀ − 1 = (cos θ − 1) + cos θ H₀₀ + sin θ H₁₀, U₁₁ − 1 = (cos θ − 1) + cos θ H₁₁ − sin θ H₀₁,
+        // U₀₁ + U₁₀ = cos θ (H₀₁ + H₁₀) + sin θ (H₁₁ − H₀₀).
+        let eps: Sym6 = [
+            cm1 + co * h[0] + si * h[2],
+            cm1 + co * h[3] - si * h[1],
+            0.0,
+            0.5 * (co * (h[1] + h[2]) + si * (h[3] - h[0])),
+            0.0,
+            0.0,
+        ];
         let de: Sym6 = [
             eps[0] - strain[0],
             eps[1] - strain[1],
@@ -316,17 +328,20 @@ impl Mechanics {
             c[2] as usize * 3,
             c[3] as usize * 3,
         ];
-        let p = |nn: usize, k: usize| inp.x0[nn + k] + inp.u[nn + k];
         let m: &[f64] = &self.geo.dm_inv[9 * e..9 * e + 9];
-        let mut ds = [0.0; 9];
+        // F = I + H with H = [u_j − u₀] D_m⁻¹ from displacement differences (see 2D).
+        let mut du = [0.0; 9];
         for i in 0..3 {
-            let o = p(n[0], i);
+            let o = inp.u[n[0] + i];
             for j in 0..3 {
-                ds[3 * i + j] = p(n[j + 1], i) - o;
+                du[3 * i + j] = inp.u[n[j + 1] + i] - o;
             }
         }
         let mm: [f64; 9] = m.try_into().expect("9 values");
-        let f = crate::kinematics::mul3(&ds, &mm);
+        let mut f = crate::kinematics::mul3(&du, &mm);
+        f[0] += 1.0;
+        f[4] += 1.0;
+        f[8] += 1.0;
         let r_prev: [f64; 9] = (&*rot).try_into().expect("9 values");
         let r = polar_3d(&f, &r_prev);
         rot.copy_from_slice(&r);
@@ -555,7 +570,6 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
         let ns = self.n_state.max(1);
         let inp = StepInputs {
             conn: ctx.kin.mesh.elements(),
-            x0: ctx.kin.mesh.coords(),
             u: ctx.kin.u,
             v: ctx.kin.v,
             damping: ctx.kin.damping,

@@ -208,8 +208,7 @@ impl GpuRun {
         let mut buffers = Vec::with_capacity(decls.len());
         for dcl in &decls {
             let size = ((dcl.len * eb(dcl.elem)).max(16) as u64).next_multiple_of(16);
-            if size > limits.max_storage_buffer_binding_size as u64 || size > limits.max_buffer_size
-            {
+            if size > limits.max_storage_buffer_binding_size || size > limits.max_buffer_size {
                 return Err(ComputeError::Gpu(format!(
                     "buffer '{}' needs {size} bytes, above the device's storage-buffer limit ({} bytes)",
                     dcl.label, limits.max_storage_buffer_binding_size

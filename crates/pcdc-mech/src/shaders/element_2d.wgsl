@@ -6,12 +6,6 @@ fn kernel(e: u32) {
     let n0 = conn[3u * e] * 2u;
     let n1 = conn[3u * e + 1u] * 2u;
     let n2 = conn[3u * e + 2u] * 2u;
-    let x0 = coords[n0] + disp[n0];
-    let x1 = coords[n0 + 1u] + disp[n0 + 1u];
-    let x2 = coords[n1] + disp[n1];
-    let x3 = coords[n1 + 1u] + disp[n1 + 1u];
-    let x4 = coords[n2] + disp[n2];
-    let x5 = coords[n2 + 1u] + disp[n2 + 1u];
     let g = e * GEO;
     let m0 = geo[g];
     let m1 = geo[g + 1u];
@@ -19,29 +13,32 @@ fn kernel(e: u32) {
     let m3 = geo[g + 3u];
     let vol = geo[g + 4u];
     let cv = geo[g + 5u];
-    let ds0 = x2 - x0;
-    let ds1 = x4 - x0;
-    let ds2 = x3 - x1;
-    let ds3 = x5 - x1;
-    let f0 = ds0 * m0 + ds1 * m2;
-    let f1 = ds0 * m1 + ds1 * m3;
-    let f2 = ds2 * m0 + ds3 * m2;
-    let f3 = ds2 * m1 + ds3 * m3;
-    // Polar decomposition in closed form: R = [[co, −si], [si, co]].
-    let pc = f0 + f3;
-    let ps = f2 - f1;
+    // H = [u₁ − u₀, u₂ − u₀] D_m⁻¹, F = I + H (displacement differences keep small strains).
+    let d0 = disp[n1] - disp[n0];
+    let d1 = disp[n2] - disp[n0];
+    let d2 = disp[n1 + 1u] - disp[n0 + 1u];
+    let d3 = disp[n2 + 1u] - disp[n0 + 1u];
+    let h0 = d0 * m0 + d1 * m2;
+    let h1 = d0 * m1 + d1 * m3;
+    let h2 = d2 * m0 + d3 * m2;
+    let h3 = d2 * m1 + d3 * m3;
+    // Polar decomposition in closed form: R = [[co, −si], [si, co]], cm1 = co − 1.
+    let pc = 2.0 + (h0 + h3);
+    let ps = h2 - h1;
     let pr = sqrt(pc * pc + ps * ps);
     var co = Real(1.0);
     var si = Real(0.0);
+    var cm1 = Real(0.0);
     if pr > 0.0 {
         co = pc / pr;
         si = ps / pr;
+        if pc >= 0.0 {
+            cm1 = -(ps * ps) / (pr * (pc + pr));
+        } else {
+            cm1 = co - 1.0;
+        }
     }
-    let u00 = co * f0 + si * f2;
-    let u01 = co * f1 + si * f3;
-    let u10 = -si * f0 + co * f2;
-    let u11 = -si * f1 + co * f3;
-    let eps = Sym(u00 - 1.0, u11 - 1.0, 0.0, 0.5 * (u01 + u10), 0.0, 0.0);
+    let eps = Sym(cm1 + co * h0 + si * h2, cm1 + co * h3 - si * h1, 0.0, 0.5 * (co * (h1 + h2) + si * (h3 - h0)), 0.0, 0.0);
     let de = Sym(eps[0] - strain[3u * e], eps[1] - strain[3u * e + 1u], 0.0, eps[3] - strain[3u * e + 2u], 0.0, 0.0);
     strain[3u * e] = eps[0];
     strain[3u * e + 1u] = eps[1];

@@ -70,14 +70,18 @@ fn kernel(e: u32) {
     }
     let vol = geo[g + 9u];
     let cv = geo[g + 10u];
-    var ds: M3;
+    // F = I + H, H = [u_j − u₀] D_m⁻¹ (displacement differences keep small strains).
+    var du: M3;
     for (var i = 0u; i < 3u; i = i + 1u) {
-        let o = coords[n[0] + i] + disp[n[0] + i];
+        let o = disp[n[0] + i];
         for (var j = 0u; j < 3u; j = j + 1u) {
-            ds[3u * i + j] = (coords[n[j + 1u] + i] + disp[n[j + 1u] + i]) - o;
+            du[3u * i + j] = disp[n[j + 1u] + i] - o;
         }
     }
-    let f = mul3(ds, mm);
+    var f = mul3(du, mm);
+    f[0] = f[0] + 1.0;
+    f[4] = f[4] + 1.0;
+    f[8] = f[8] + 1.0;
     var r_prev: M3;
     for (var k = 0u; k < 9u; k = k + 1u) {
         r_prev[k] = rotation[9u * e + k];
