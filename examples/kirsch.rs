@@ -5,16 +5,35 @@
 //! `out/kirsch/kirsch.png` and the finest solutions as `out/kirsch/kirsch_*.pvd`
 //! (open in ParaView: displacement, stress, principal stresses), and ends with one
 //! RESULT line per solver.
+//!
+//! Backend: `--backend cpu|gpu` (default `cpu`, or `PCDC_BACKEND`) and, on the GPU,
+//! `--precision f64|f32` (default f64 where the adapter supports it, or
+//! `PCDC_PRECISION`); the RESULT lines carry `backend=` and `precision=`, e.g.
+//! `cargo run --release --example kirsch -- --backend gpu --precision f32`. The direct
+//! solve factorises on the host (faer) and is the same on both backends, so with
+//! `--backend gpu` only dynamic relaxation runs (on the device) and the example ends
+//! with its one RESULT line.
 
+use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
 use pcdc::plot::Plot;
 use pcdc::report::{out_dir, ResultLine};
 use pcdc::scenes::kirsch::{self, Params, Solver};
 
 fn main() {
-    pcdc::report::finish(run())
+    pcdc::report::finish(choose())
 }
 
-fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+/// Runs the scene on the backend named on the command line.
+fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    let choice = pcdc::report::backend_choice()?;
+    match choice.kind {
+        BackendKind::Cpu => run(&CpuBackend::new(0)?),
+        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
+    }
+}
+
+fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", pcdc::report::describe_backend(backend));
     let full = Params::full();
     println!("Kirsch: hole radius a = {} m, ring to 25a, E = 50 GPa, nu = 0.25, P1 = 10 MPa (x), P2 = 5 MPa (y)", full.radius);
     println!(
@@ -22,7 +41,12 @@ fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
         "solver", "size/a", "elements", "error", "steps", "wall_s"
     );
     let mut finals = Vec::new();
-    for solver in [Solver::Direct, Solver::Relaxation] {
+    let solvers: &[Solver] = match backend.kind() {
+        BackendKind::Cpu => &[Solver::Direct, Solver::Relaxation],
+        // The direct solve is a host solve, identical on both backends.
+        BackendKind::Gpu => &[Solver::Relaxation],
+    };
+    for &solver in solvers {
         for size in [0.1, 0.05, full.size_at_hole] {
             let vtu_dir = (size == full.size_at_hole)
                 .then(|| out_dir("kirsch"))
@@ -32,7 +56,7 @@ fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
                 vtu_dir,
                 ..full.clone()
             };
-            let out = kirsch::run(&p, solver)?;
+            let out = kirsch::run(backend, &p, solver)?;
             println!(
                 "{:>10} {:>10.3} {:>9} {:>10.4} {:>8} {:>9.3}",
                 solver.name(),
@@ -83,7 +107,8 @@ fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
     Ok(finals
         .iter()
         .map(|out| {
-            ResultLine::cpu(
+            ResultLine::new(
+                backend,
                 "kirsch",
                 &format!("max_rel_err_{}", out.solver.name()),
                 out.error,

@@ -4,16 +4,32 @@
 //! `cargo run --release --example vibration_energy` prints a drift table, writes
 //! `out/vibration_energy/vibration_energy.png` and ends with the RESULT line (worst of
 //! 2D and 3D at the finest size).
+//!
+//! Backend: `--backend cpu|gpu` (default `cpu`, or `PCDC_BACKEND`) and, on the GPU,
+//! `--precision f64|f32` (default f64 where the adapter supports it, or
+//! `PCDC_PRECISION`); the RESULT line carries `backend=` and `precision=`, e.g.
+//! `cargo run --release --example vibration_energy -- --backend gpu --precision f32`.
 
+use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
 use pcdc::plot::Plot;
 use pcdc::report::{out_dir, ResultLine};
 use pcdc::scenes::vibration_energy::{self, Params};
 
 fn main() {
-    pcdc::report::finish(run())
+    pcdc::report::finish(choose())
 }
 
-fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+/// Runs the scene on the backend named on the command line.
+fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    let choice = pcdc::report::backend_choice()?;
+    match choice.kind {
+        BackendKind::Cpu => run(&CpuBackend::new(0)?),
+        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
+    }
+}
+
+fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", pcdc::report::describe_backend(backend));
     let full = Params::full();
     println!(
         "Undamped free vibration of an elastic block, {} periods of its first extensional mode",
@@ -30,8 +46,8 @@ fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
             ..full.clone()
         };
         for (dim, out) in [
-            ("2d", vibration_energy::run_2d(&p)?),
-            ("3d", vibration_energy::run_3d(&p)?),
+            ("2d", vibration_energy::run_2d(backend, &p)?),
+            ("3d", vibration_energy::run_3d(backend, &p)?),
         ] {
             println!(
                 "{:>4} {:>8.4} {:>9} {:>11.3e} {:>8} {:>8.3}",
@@ -70,7 +86,8 @@ fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
         .iter()
         .max_by(|a, b| a.1.drift.total_cmp(&b.1.drift))
         .expect("two runs");
-    Ok(vec![ResultLine::cpu(
+    Ok(vec![ResultLine::new(
+        backend,
         "vibration_energy",
         "max_rel_energy_drift",
         worst.1.drift,

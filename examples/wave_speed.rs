@@ -3,16 +3,32 @@
 //! `cargo run --release --example wave_speed` prints an error table, writes
 //! `out/wave_speed/wave_speed.png` (probe velocities against time, with the analytic
 //! arrival times) and ends with the RESULT line (worst of 2D and 3D at the finest size).
+//!
+//! Backend: `--backend cpu|gpu` (default `cpu`, or `PCDC_BACKEND`) and, on the GPU,
+//! `--precision f64|f32` (default f64 where the adapter supports it, or
+//! `PCDC_PRECISION`); the RESULT line carries `backend=` and `precision=`, e.g.
+//! `cargo run --release --example wave_speed -- --backend gpu --precision f32`.
 
+use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
 use pcdc::plot::Plot;
 use pcdc::report::{out_dir, ResultLine};
 use pcdc::scenes::wave_speed::{self, Params};
 
 fn main() {
-    pcdc::report::finish(run())
+    pcdc::report::finish(choose())
 }
 
-fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+/// Runs the scene on the backend named on the command line.
+fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    let choice = pcdc::report::backend_choice()?;
+    match choice.kind {
+        BackendKind::Cpu => run(&CpuBackend::new(0)?),
+        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
+    }
+}
+
+fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", pcdc::report::describe_backend(backend));
     let full = Params::full();
     println!(
         "P-wave speed, bar 1 m on rollers, E = 30 GPa, nu = 0.25, rho = 2600: c = {:.2} m/s",
@@ -24,13 +40,10 @@ fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
     );
     let mut finals = Vec::new();
     for size in [4.0 * full.size, 2.0 * full.size, full.size] {
-        let p = Params {
-            size,
-            ..full.clone()
-        };
+        let p = Params { size };
         for (dim, out) in [
-            ("2d", wave_speed::run_2d(&p)?),
-            ("3d", wave_speed::run_3d(&p)?),
+            ("2d", wave_speed::run_2d(backend, &p)?),
+            ("3d", wave_speed::run_3d(backend, &p)?),
         ] {
             println!(
                 "{:>4} {:>8.4} {:>9} {:>10.2} {:>9.5} {:>7} {:>8.3}",
@@ -67,7 +80,8 @@ fn run() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
         .iter()
         .max_by(|a, b| a.1.error.total_cmp(&b.1.error))
         .expect("two runs");
-    Ok(vec![ResultLine::cpu(
+    Ok(vec![ResultLine::new(
+        backend,
         "wave_speed",
         "rel_err_p_wave_speed",
         worst.1.error,

@@ -1,11 +1,18 @@
-//! Reduced-size validation scenes: the same tolerances as the full examples.
+//! Reduced-size validation scenes on the CPU backend (2 threads): the same tolerances as
+//! the full examples.
 
+use pcdc::compute::CpuBackend;
 use pcdc::scenes::{kirsch, vibration_energy, wave_speed};
+
+fn cpu() -> CpuBackend {
+    CpuBackend::new(2).unwrap()
+}
 
 #[test]
 fn kirsch_direct_and_relaxation_within_3_percent() {
+    let cpu = cpu();
     for solver in [kirsch::Solver::Direct, kirsch::Solver::Relaxation] {
-        let out = kirsch::run(&kirsch::Params::reduced(), solver).unwrap();
+        let out = kirsch::run(&cpu, &kirsch::Params::reduced(), solver).unwrap();
         eprintln!(
             "kirsch {:?}: error {:.4} elements {} steps {} wall {:.2}s",
             solver, out.error, out.elements, out.steps, out.wall_s
@@ -16,10 +23,10 @@ fn kirsch_direct_and_relaxation_within_3_percent() {
 
 #[test]
 fn wave_speed_within_2_percent_2d_and_3d() {
-    let p = wave_speed::Params::reduced();
+    let (cpu, p) = (cpu(), wave_speed::Params::reduced());
     for (name, out) in [
-        ("2d", wave_speed::run_2d(&p).unwrap()),
-        ("3d", wave_speed::run_3d(&p).unwrap()),
+        ("2d", wave_speed::run_2d(&cpu, &p).unwrap()),
+        ("3d", wave_speed::run_3d(&cpu, &p).unwrap()),
     ] {
         eprintln!(
             "wave {name}: c_num {:.1} c {:.1} error {:.4} elements {} steps {}",
@@ -31,10 +38,10 @@ fn wave_speed_within_2_percent_2d_and_3d() {
 
 #[test]
 fn vibration_energy_drift_below_half_percent_2d_and_3d() {
-    let p = vibration_energy::Params::reduced();
+    let (cpu, p) = (cpu(), vibration_energy::Params::reduced());
     for (name, out) in [
-        ("2d", vibration_energy::run_2d(&p).unwrap()),
-        ("3d", vibration_energy::run_3d(&p).unwrap()),
+        ("2d", vibration_energy::run_2d(&cpu, &p).unwrap()),
+        ("3d", vibration_energy::run_3d(&cpu, &p).unwrap()),
     ] {
         eprintln!(
             "energy {name}: drift {:.2e} elements {} steps {}",
@@ -54,7 +61,7 @@ fn vibration_energy_drift_below_half_percent_2d_and_3d() {
 #[test]
 fn direct_tension_peak_at_ts_and_crack_across_the_neck() {
     use pcdc::scenes::direct_tension as dt;
-    let out = dt::run(&dt::Params::reduced()).unwrap();
+    let out = dt::run(&cpu(), &dt::Params::reduced()).unwrap();
     eprintln!("direct tension: peak {:.3} MPa ({:+.2} %), elements {}, joints {}, broken {}, steps {}, wall {:.2}s", out.peak / 1e6, 100.0 * out.deviation, out.elements, out.joints, out.broken.len(), out.steps, out.wall_s);
     assert!(
         out.band_metric() <= 1.0,
@@ -88,8 +95,9 @@ fn direct_tension_peak_at_ts_and_crack_across_the_neck() {
 #[test]
 fn block_sliding_stops_within_3_percent() {
     use pcdc::scenes::block_sliding;
+    let cpu = cpu();
     for v0 in [1.0, 2.0] {
-        let o = block_sliding::run(v0, 2).unwrap();
+        let o = block_sliding::run(&cpu, v0).unwrap();
         eprintln!(
             "block sliding v0 {v0}: {:.5} m vs {:.5} m ({:.3} %), {} steps, {:.1} s",
             o.distance,
@@ -100,4 +108,18 @@ fn block_sliding_stops_within_3_percent() {
         );
         assert!(o.error <= block_sliding::TOL, "v0 {v0}: error {}", o.error);
     }
+}
+
+#[test]
+fn result_line_names_the_backend_it_ran_on() {
+    let line = pcdc::report::ResultLine::new(&cpu(), "case", "metric", 0.01, 0.03, 10, 5, 0.5);
+    let text = line.to_string();
+    assert!(text.ends_with(" backend=cpu precision=f64"), "{text}");
+    assert!(text.contains(" pass=true "), "{text}");
+    let args = |s: &[&str]| s.iter().map(|a| a.to_string()).collect::<Vec<_>>();
+    assert!(
+        pcdc::report::check_backend_args(&args(&["--backend", "gpu", "--precision=f32"])).is_ok()
+    );
+    assert!(pcdc::report::check_backend_args(&args(&["--backend"])).is_err());
+    assert!(pcdc::report::check_backend_args(&args(&["--backed", "gpu"])).is_err());
 }

@@ -9,7 +9,7 @@
 
 use std::time::Instant;
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Mesh, Range};
@@ -54,13 +54,13 @@ fn block_on_base(size: f64, length: f64) -> Result<Mesh<Dim2>, SceneError> {
     Ok(builders::union(&[&base, &block])?.0)
 }
 
-/// Runs one initial speed `v0` (m/s) on `threads` threads (0 = all cores).
-pub fn run(v0: f64, threads: usize) -> Result<Outcome, SceneError> {
+/// Runs one initial speed `v0` (m/s) on `backend` (cloned into the simulation).
+pub fn run<B: Backend>(backend: &B, v0: f64) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let d_exact = expected(v0);
     let mesh = block_on_base(0.025, 0.3 + 1.2 * d_exact)?;
     let rock = LinearElastic::new(E, 0.25, 1000.0)?.with_damping(1.0)?;
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(threads)?)
+    let mut sim = Simulation::builder(mesh, backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(Contact::new(10.0 * E).friction(PHI, 10.0 * E))
         .physics(Boundary::new().fix(Range::rect(-1.0, -1.0, 1e3, BASE_TOP - 1e-9)))
@@ -78,14 +78,14 @@ pub fn run(v0: f64, threads: usize) -> Result<Outcome, SceneError> {
     for &n in &nodes {
         sim.state.v[2 * n as usize] = v0;
     }
-    let mean_x = |s: &Simulation<Dim2>| {
+    let mean_x = |s: &Simulation<Dim2, B>| {
         nodes
             .iter()
             .map(|&n| s.mesh().node(n as usize)[0] + s.state.u[2 * n as usize])
             .sum::<f64>()
             / nodes.len() as f64
     };
-    let mean_vx = |s: &Simulation<Dim2>| {
+    let mean_vx = |s: &Simulation<Dim2, B>| {
         nodes
             .iter()
             .map(|&n| s.state.v[2 * n as usize])

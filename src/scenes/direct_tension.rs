@@ -16,7 +16,7 @@
 use std::time::Instant;
 
 use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, JOINT_DAMAGE};
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{output, Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::vtu::{DataArray, PvdSeries};
 use pcdc_mesh::{builders, Range};
@@ -41,8 +41,6 @@ const RAMP: f64 = 2e-4;
 pub struct Params {
     /// Element size (m).
     pub size: f64,
-    /// Worker threads (0 = all cores).
-    pub threads: usize,
     /// Folder for a VTU/PVD series (ParaView), if any.
     pub vtu_dir: Option<std::path::PathBuf>,
 }
@@ -52,7 +50,6 @@ impl Params {
     pub fn full() -> Self {
         Params {
             size: 0.002,
-            threads: 0,
             vtu_dir: None,
         }
     }
@@ -60,7 +57,6 @@ impl Params {
     pub fn reduced() -> Self {
         Params {
             size: 0.005,
-            threads: 2,
             vtu_dir: None,
         }
     }
@@ -101,8 +97,8 @@ impl Outcome {
     }
 }
 
-/// Runs the scene.
-pub fn run(p: &Params) -> Result<Outcome, SceneError> {
+/// Runs the scene on `backend` (cloned into the simulation).
+pub fn run<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let mesh = builders::dog_bone(0.05, 0.15, 0.15, NECK, p.size)?;
     let split = split_nodes(&mesh, &Range::All)?;
@@ -111,7 +107,7 @@ pub fn run(p: &Params) -> Result<Outcome, SceneError> {
     let joints = split.joints.clone();
     let up = pcdc_compute::Table::new("edge velocity", &[(0.0, 0.0), (RAMP, V)])?;
     let down = pcdc_compute::Table::new("edge velocity", &[(0.0, 0.0), (RAMP, -V)])?;
-    let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(p.threads)?)
+    let mut sim = Simulation::builder(split.mesh.clone(), backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(CohesiveJoints::new(joints.clone()).model(Range::All, czm))
         .physics(
@@ -187,9 +183,9 @@ pub fn run(p: &Params) -> Result<Outcome, SceneError> {
 
 /// One VTU frame: displacement, global stress and, per element, the largest damage of
 /// its joints.
-fn write_frame(
+fn write_frame<B: Backend>(
     series: &mut PvdSeries,
-    sim: &Simulation<pcdc_mesh::Dim2>,
+    sim: &Simulation<pcdc_mesh::Dim2, B>,
     joints: &pcdc_cohesive::Joints,
 ) -> Result<(), SceneError> {
     let damage = sim.field(JOINT_DAMAGE)?;

@@ -16,7 +16,7 @@
 
 use std::time::Instant;
 
-use pcdc_compute::{CpuBackend, Simulation, StaticOptions};
+use pcdc_compute::{Backend, Simulation, StaticOptions};
 use pcdc_mech::{output, Boundary, Constraint, FaceStress, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Mesh, Range};
 
@@ -55,8 +55,6 @@ pub struct Params {
     pub radius: f64,
     /// Element size at the hole, as a fraction of a.
     pub size_at_hole: f64,
-    /// Worker threads (0 = all cores).
-    pub threads: usize,
     /// Folder for a VTU/PVD file of the solution (ParaView), if any.
     pub vtu_dir: Option<std::path::PathBuf>,
 }
@@ -67,7 +65,6 @@ impl Params {
         Params {
             radius: 0.1,
             size_at_hole: 0.025,
-            threads: 0,
             vtu_dir: None,
         }
     }
@@ -76,7 +73,6 @@ impl Params {
         Params {
             radius: 0.1,
             size_at_hole: 0.05,
-            threads: 2,
             vtu_dir: None,
         }
     }
@@ -139,13 +135,15 @@ pub fn mesh(p: &Params) -> Result<Mesh<Dim2>, SceneError> {
     Ok(m)
 }
 
-/// Runs the scene with one solver.
-pub fn run(p: &Params, solver: Solver) -> Result<Outcome, SceneError> {
+/// Runs the scene with one solver on `backend` (cloned into the simulation). The direct
+/// solve factorises on the host (faer) on every backend; dynamic relaxation steps on the
+/// backend.
+pub fn run<B: Backend>(backend: &B, p: &Params, solver: Solver) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let mesh = mesh(p)?;
     let a = p.radius;
     let rock = LinearElastic::new(50e9, 0.25, 2500.0)?.with_damping(1.0)?;
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(p.threads)?)
+    let mut sim = Simulation::builder(mesh, backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(
             Boundary::new()
@@ -178,7 +176,14 @@ pub fn run(p: &Params, solver: Solver) -> Result<Outcome, SceneError> {
             check_every: 1,
         })?,
         Solver::Relaxation => sim.relax(&StaticOptions {
-            tolerance: 1e-6,
+            // In f32 the unbalanced-force ratio levels off near 1e-5 (forces are sums of
+            // element forces that cancel to ~1e-7 of their size), so ask for what f32
+            // can deliver; its larger stress error is then reported as measured.
+            tolerance: if backend.precision() == "f32" {
+                1e-4
+            } else {
+                1e-6
+            },
             max_steps: 400_000,
             check_every: 50,
         })?,

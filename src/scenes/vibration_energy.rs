@@ -12,7 +12,7 @@
 
 use std::time::Instant;
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim, Mesh, Range};
 
@@ -31,8 +31,6 @@ pub struct Params {
     pub size: f64,
     /// Number of periods.
     pub periods: f64,
-    /// Worker threads (0 = all cores).
-    pub threads: usize,
 }
 
 impl Params {
@@ -41,7 +39,6 @@ impl Params {
         Params {
             size: 0.01,
             periods: 10.0,
-            threads: 0,
         }
     }
     /// Reduced size for tests.
@@ -49,7 +46,6 @@ impl Params {
         Params {
             size: 0.05,
             periods: 10.0,
-            threads: 2,
         }
     }
 }
@@ -73,12 +69,16 @@ pub struct Outcome {
     pub strain_energy: Vec<f64>,
 }
 
-fn run_on<D: Dim>(mesh: Mesh<D>, p: &Params) -> Result<Outcome, SceneError> {
+fn run_on<D: Dim, B: Backend>(
+    backend: &B,
+    mesh: Mesh<D>,
+    p: &Params,
+) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let (lo, hi) = mesh.bounding_box();
     let length = hi[0] - lo[0];
     let rock = LinearElastic::new(E, NU, RHO)?;
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(p.threads)?)
+    let mut sim = Simulation::builder(mesh, backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))
         .build()?;
     let d = D::D;
@@ -130,14 +130,19 @@ fn rock_modulus() -> f64 {
     E * (1.0 - NU) / ((1.0 + NU) * (1.0 - 2.0 * NU))
 }
 
-/// The 2D block 1 m × 0.25 m.
-pub fn run_2d(p: &Params) -> Result<Outcome, SceneError> {
-    run_on(builders::rectangle(0.0, 0.0, 1.0, 0.25, p.size)?, p)
+/// The 2D block 1 m × 0.25 m, on `backend`.
+pub fn run_2d<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
+    run_on(
+        backend,
+        builders::rectangle(0.0, 0.0, 1.0, 0.25, p.size)?,
+        p,
+    )
 }
 
-/// The 3D block 1 m × 0.25 m × 0.25 m (element size 2.5× the 2D one).
-pub fn run_3d(p: &Params) -> Result<Outcome, SceneError> {
+/// The 3D block 1 m × 0.25 m × 0.25 m (element size 2.5× the 2D one), on `backend`.
+pub fn run_3d<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
     run_on(
+        backend,
         builders::cuboid([0.0; 3], [1.0, 0.25, 0.25], 2.5 * p.size)?,
         p,
     )

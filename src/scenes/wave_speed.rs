@@ -10,7 +10,7 @@
 
 use std::time::Instant;
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{Boundary, Constraint, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim, Range};
 
@@ -29,24 +29,16 @@ const LENGTH: f64 = 1.0;
 pub struct Params {
     /// Element size (m).
     pub size: f64,
-    /// Worker threads (0 = all cores).
-    pub threads: usize,
 }
 
 impl Params {
     /// Full size (5 mm elements).
     pub fn full() -> Self {
-        Params {
-            size: 0.005,
-            threads: 0,
-        }
+        Params { size: 0.005 }
     }
     /// Reduced size for tests (2 cm elements).
     pub fn reduced() -> Self {
-        Params {
-            size: 0.02,
-            threads: 2,
-        }
+        Params { size: 0.02 }
     }
 }
 
@@ -78,10 +70,10 @@ pub fn c_exact() -> f64 {
     (E * (1.0 - NU) / (RHO * (1.0 + NU) * (1.0 - 2.0 * NU))).sqrt()
 }
 
-fn run_on<D: Dim>(
+fn run_on<D: Dim, B: Backend>(
+    backend: &B,
     mesh: pcdc_mesh::Mesh<D>,
     side_groups: &[&str],
-    threads: usize,
 ) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let rock = LinearElastic::new(E, NU, RHO)?;
@@ -96,12 +88,12 @@ fn run_on<D: Dim>(
         };
         bc = bc.constraint(Range::group(*g), Constraint::Plane(normal));
     }
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(threads)?)
+    let mut sim = Simulation::builder(mesh, backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(bc)
         .build()?;
     let d = D::D;
-    let section = |sim: &Simulation<D>, x: f64| -> Result<Vec<u32>, SceneError> {
+    let section = |sim: &Simulation<D, B>, x: f64| -> Result<Vec<u32>, SceneError> {
         let (lo, hi) = sim.mesh().edge_length_range();
         let tol = lo.min(hi);
         let nodes = sim
@@ -123,7 +115,7 @@ fn run_on<D: Dim>(
     let (s1, s2) = (section(&sim, 0.25 * LENGTH)?, section(&sim, 0.75 * LENGTH)?);
     let x1 = sim.mesh().node(s1[0] as usize)[0];
     let x2 = sim.mesh().node(s2[0] as usize)[0];
-    let mean_v = |sim: &Simulation<D>, s: &[u32]| {
+    let mean_v = |sim: &Simulation<D, B>, s: &[u32]| {
         s.iter().map(|&n| sim.state.v[n as usize * d]).sum::<f64>() / s.len() as f64
     };
     let c = c_exact();
@@ -170,14 +162,15 @@ fn run_on<D: Dim>(
     })
 }
 
-/// The 2D bar (height 0.1 m), rollers on top and bottom.
-pub fn run_2d(p: &Params) -> Result<Outcome, SceneError> {
+/// The 2D bar (height 0.1 m), rollers on top and bottom, on `backend`.
+pub fn run_2d<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
     let mesh = builders::rectangle(0.0, 0.0, LENGTH, 0.1, p.size)?;
-    run_on(mesh, &["bottom", "top"], p.threads)
+    run_on(backend, mesh, &["bottom", "top"])
 }
 
-/// The 3D bar (section 0.05 × 0.05 m, coarser: 2× the 2D size), rollers on the four sides.
-pub fn run_3d(p: &Params) -> Result<Outcome, SceneError> {
+/// The 3D bar (section 0.05 × 0.05 m, coarser: 2× the 2D size), rollers on the four
+/// sides, on `backend`.
+pub fn run_3d<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
     let mesh = builders::cuboid([0.0; 3], [LENGTH, 0.05, 0.05], 2.0 * p.size)?;
-    run_on(mesh, &["ymin", "ymax", "zmin", "zmax"], p.threads)
+    run_on(backend, mesh, &["ymin", "ymax", "zmin", "zmax"])
 }
