@@ -5,25 +5,34 @@
 //! top pushed at 0.05 m/s, dt = 0.05 h / c_p; 10k, 50k and 200k triangles, 1 thread and
 //! all threads.
 //!
+//! GPU rows (when an adapter exists, f64 and f32): one iteration is `run(GPU_STEPS)`,
+//! which includes one upload and one read-back of the state, so the rate is per
+//! triangle-step with the transfers amortised over GPU_STEPS steps. On a software adapter
+//! (Mesa's lavapipe) only the 10k mesh runs, and its rows prove that the path works, not
+//! GPU speed.
+//!
 //! Run: `cargo bench --bench fdem_step`. Criterion reports elements/s = triangle-steps/s;
 //! joint-steps/s = triangle-steps/s x joints/triangles (about 1.5), printed once per mesh.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm};
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, CpuBackend, Precision, Simulation, WgpuBackend};
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
 
 const E: f64 = 30e9;
 
-fn scene(cells_x: usize, threads: usize) -> Simulation<Dim2> {
+/// Steps per measured GPU iteration.
+const GPU_STEPS: u64 = 20;
+
+fn scene<B: Backend>(cells_x: usize, backend: B) -> Simulation<Dim2, B> {
     let h = 0.05 / cells_x as f64;
     let mesh = builders::rectangle(0.0, 0.0, 0.05, 0.10, h).unwrap();
     let split = split_nodes(&mesh, &Range::All).unwrap();
     let czm = IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, 10.0 * E, 10.0 * E, 100.0 * E).unwrap();
     let rock = LinearElastic::new(E, 0.25, 2600.0).unwrap();
     let c_p = ((rock.lambda() + 2.0 * rock.shear()) / 2600.0).sqrt();
-    Simulation::builder(split.mesh, CpuBackend::new(threads).unwrap())
+    Simulation::builder(split.mesh, backend)
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
         .physics(
@@ -50,7 +59,7 @@ fn bench(c: &mut Criterion) {
     // nx x 2nx cells of 2 triangles: 50 -> 10k, 112 -> 50k, 224 -> 201k.
     for nx in [50, 112, 224] {
         for &t in &threads {
-            let mut sim = scene(nx, t);
+            let mut sim = scene(nx, CpuBackend::new(t).unwrap());
             let n = sim.mesh().n_elements();
             if t == 1 {
                 let joints = sim.field(pcdc_cohesive::JOINT_DAMAGE).unwrap().len();
@@ -60,6 +69,36 @@ fn bench(c: &mut Criterion) {
             g.bench_function(format!("tri3_{}k_joints_threads_{t}", n / 1000), |b| {
                 b.iter(|| sim.step().unwrap())
             });
+        }
+    }
+    for p in [Precision::F64, Precision::F32] {
+        let gpu = match WgpuBackend::new(Some(p)) {
+            Ok(b) => b,
+            Err(e) => {
+                eprintln!("no GPU rows in {}: {e}", p.name());
+                continue;
+            }
+        };
+        let name = if gpu.is_software() { "lavapipe" } else { "gpu" };
+        let sizes: &[usize] = if gpu.is_software() {
+            &[50]
+        } else {
+            &[50, 112, 224]
+        };
+        for &nx in sizes {
+            let mut sim = scene(nx, gpu.clone());
+            let n = sim.mesh().n_elements();
+            eprintln!(
+                "fdem_step {name} {}: {n} triangles, {:.0} bytes per triangle-step, adapter {}",
+                p.name(),
+                sim.gpu_bytes_per_step().unwrap_or(0) as f64 / n as f64,
+                gpu.adapter_name()
+            );
+            g.throughput(Throughput::Elements(n as u64 * GPU_STEPS));
+            g.bench_function(
+                format!("tri3_{}k_joints_{name}_{}", n / 1000, p.name()),
+                |b| b.iter(|| sim.run(GPU_STEPS).unwrap()),
+            );
         }
     }
     g.finish();

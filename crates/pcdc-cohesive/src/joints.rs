@@ -11,9 +11,14 @@
 //! Fields: `joint_state` (model history per Gauss point), `joint_damage` (largest D per
 //! joint, for output), and `broken_face` (1 on both faces of a fully broken joint, on
 //! the split mesh's faces: the field contact picks up).
+//!
+//! On the GPU backend one kernel (`shaders/joints.wgsl`, one invocation per joint)
+//! repeats this arithmetic in the same order, with each model's WGSL body
+//! ([`crate::WgslJointModel`]) spliced in; it writes the same slots and fields.
 
 use std::sync::Arc;
 
+use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase};
 use pcdc_compute::{
     Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext, Kinematics,
     Location, Physics, StableStep,
@@ -22,6 +27,9 @@ use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
 use crate::{JointModel, Joints};
+
+const JOINT_KERNEL: &str = include_str!("shaders/joints.wgsl");
+const JOINT_LIBRARY: &str = include_str!("shaders/joint_library.wgsl");
 
 /// Name of the joint history field.
 pub const JOINT_STATE: &str = "joint_state";
@@ -398,5 +406,218 @@ impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
             }
         }
         Ok(())
+    }
+
+    fn gpu_setup(&mut self, setup: &mut GpuSetup<'_, D>) -> Result<(), ComputeError> {
+        let nj = self.joints.len();
+        if nj == 0 {
+            return Ok(());
+        }
+        if self.model_of.len() != nj {
+            return Err(ComputeError::Gpu(
+                "cohesive joints: GPU setup before init".to_string(),
+            ));
+        }
+        let npf = D::NODES_PER_FACE;
+        // Real data: Gauss points (N_0, N_1, N_2, w), then the model parameters, then h.
+        let mut data = Vec::with_capacity(4 * self.rule.len() + nj);
+        for (shape, w) in &self.rule {
+            data.extend_from_slice(shape);
+            data.push(*w);
+        }
+        // One WGSL function per distinct model key; parameters per model.
+        let mut keys: Vec<String> = Vec::new();
+        let mut functions = String::new();
+        let mut model_info = Vec::with_capacity(self.models.len());
+        for m in &self.models {
+            let w = m.wgsl().ok_or_else(|| ComputeError::NoGpuKernel {
+                physics: "cohesive joints".into(),
+                reason: format!(
+                    "joint model '{}' has no WGSL body (implement JointModel::wgsl)",
+                    m.name()
+                ),
+            })?;
+            let kind = match keys.iter().position(|k| *k == w.key) {
+                Some(k) => k,
+                None => {
+                    keys.push(w.key.clone());
+                    functions.push_str(&format!(
+                        "// joint model '{}'\nfn joint_model_{}(o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32) -> JointTraction {{\n{}\n}}\n",
+                        w.key,
+                        keys.len() - 1,
+                        w.body
+                    ));
+                    keys.len() - 1
+                }
+            };
+            model_info.push([kind as u32, data.len() as u32]);
+            data.extend_from_slice(&w.params);
+        }
+        let mut dispatch = String::from(
+            "fn call_joint_model(kind: u32, o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32) -> JointTraction {\n    var out: JointTraction;\n    switch kind {\n",
+        );
+        for k in 0..keys.len() {
+            dispatch.push_str(&format!(
+                "        case {k}u: {{ out = joint_model_{k}(o, slip, h, state, p); }}\n"
+            ));
+        }
+        dispatch.push_str("        default: {}\n    }\n    return out;\n}\n");
+        let h_at = data.len();
+        data.extend_from_slice(&self.h);
+        // Per joint: side A nodes, side B nodes, faces A and B, model kind, parameter offset.
+        let info_stride = 2 * npf + 4;
+        let mut info = Vec::with_capacity(nj * info_stride);
+        for j in 0..nj {
+            info.extend_from_slice(&self.joints.nodes[j * 2 * npf..(j + 1) * 2 * npf]);
+            info.extend_from_slice(&self.joints.faces[2 * j..2 * j + 2]);
+            info.extend_from_slice(&model_info[self.model_of[j] as usize]);
+        }
+        let info = setup.upload("joint info", GpuData::U32(info));
+        let data = setup.upload("joint data", GpuData::Real(data));
+        let source = format!(
+            "alias JointVec = array<Real, 3>;\nalias JointState = array<Real, NSTATE>;\nstruct JointTraction {{\n    normal: Real,\n    shear: JointVec,\n    damage: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return joint_data[p + k]; }}\n{JOINT_LIBRARY}{functions}{dispatch}{JOINT_KERNEL}"
+        );
+        let mut kernel = Kernel::new(format!("cohesive joints {}", D::NAME), source, nj)
+            .const_u32("D", D::D as u32)
+            .const_u32("NPF", npf as u32)
+            .const_u32("NGAUSS", self.rule.len() as u32)
+            .const_u32("NSTATE", self.n_state as u32)
+            .const_u32("INFO", info_stride as u32)
+            .const_u32("GAUSS_AT", 0)
+            .const_u32("H_AT", h_at as u32)
+            .const_u32("SLOT_FIRST", setup.slot_first());
+        for (name, v) in crate::model::wgsl_library_constants() {
+            kernel = kernel.const_real(&name, v);
+        }
+        let kernel = kernel
+            .bind("coords", setup.coords(), Access::Read)
+            .bind("disp", setup.displacement(), Access::Read)
+            .bind("joint_info", info, Access::Read)
+            .bind("joint_data", data, Access::Read)
+            .bind("joint_state", setup.field(JOINT_STATE)?, Access::ReadWrite)
+            .bind(
+                "joint_damage",
+                setup.field(JOINT_DAMAGE)?,
+                Access::ReadWrite,
+            )
+            .bind("broken_face", setup.field(BROKEN_FACE)?, Access::ReadWrite)
+            .bind("slots", setup.slots(), Access::ReadWrite);
+        setup.kernel(Phase::Forces, kernel)
+    }
+}
+
+#[cfg(test)]
+mod gpu_tests {
+    use super::*;
+    use crate::{split_nodes, IntrinsicCzm, MohrCoulombJoint, Traction};
+    use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
+    use pcdc_compute::{CpuBackend, Precision};
+    use pcdc_mesh::builders;
+
+    /// A joint model without a WGSL body (CPU only).
+    #[derive(Debug)]
+    struct CpuOnly;
+    impl JointModel for CpuOnly {
+        fn name(&self) -> &str {
+            "cpu-only-joint"
+        }
+        fn n_state(&self) -> usize {
+            1
+        }
+        fn traction(&self, _: f64, _: &[f64], _: f64, _: &mut [f64]) -> Traction {
+            Traction::default()
+        }
+        fn max_stiffness(&self, _: f64) -> f64 {
+            1e12
+        }
+        fn is_broken(&self, _: &[f64]) -> bool {
+            false
+        }
+    }
+
+    fn czm() -> IntrinsicCzm {
+        IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, 3e11, 3e11, 3e12).unwrap()
+    }
+
+    /// Both built-in models (CZM everywhere, Mohr-Coulomb on one half, a second CZM
+    /// with other parameters that shares the first one's WGSL function).
+    fn joints(j: Joints, gauss_3d: usize) -> CohesiveJoints {
+        let half = Range::HalfSpace {
+            point: [0.5, 0.0, 0.0],
+            normal: [1.0, 0.0, 0.0],
+        };
+        let weak = IntrinsicCzm::new(25.0, 5e6, 1e6, 0.2, 2.0, 3e11, 3e11, 3e12).unwrap();
+        CohesiveJoints::new(j)
+            .model(Range::All, czm())
+            .model(half, MohrCoulombJoint::new(30.0, 0.0, 3e12, 3e11).unwrap())
+            .model_for(vec![0, 1], weak)
+            .gauss_points_3d(gauss_3d)
+    }
+
+    #[test]
+    fn joint_kernels_validate_with_naga() {
+        let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
+        let m3 = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
+        let s2 = split_nodes(&m2, &Range::All).unwrap();
+        let s3 = split_nodes(&m3, &Range::All).unwrap();
+        for p in [Precision::F64, Precision::F32] {
+            let k2 = offline_kernel_sources::<_, CpuBackend>(
+                &s2.mesh,
+                vec![Box::new(joints(s2.joints.clone(), 3))],
+                p,
+            )
+            .unwrap();
+            let mut all = k2.clone();
+            for g in [3, 7] {
+                all.extend(
+                    offline_kernel_sources::<_, CpuBackend>(
+                        &s3.mesh,
+                        vec![Box::new(joints(s3.joints.clone(), g))],
+                        p,
+                    )
+                    .unwrap(),
+                );
+            }
+            let joint_kernels: Vec<_> = all
+                .iter()
+                .filter(|(l, _)| l.starts_with("cohesive joints"))
+                .collect();
+            assert_eq!(joint_kernels.len(), 3);
+            for (label, src) in &all {
+                if let Err(e) = validate_wgsl(src) {
+                    panic!("{label} ({}) does not validate:\n{e}", p.name());
+                }
+            }
+            // Two CZMs share one WGSL function; the Mohr-Coulomb joint has its own.
+            let (_, src) = joint_kernels[0];
+            assert_eq!(src.matches("fn joint_model_").count(), 2, "{src}");
+        }
+    }
+
+    #[test]
+    fn no_joints_no_kernel() {
+        let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        let j = CohesiveJoints::new(Joints::default());
+        let k = offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(j)], Precision::F64)
+            .unwrap();
+        assert!(k.iter().all(|(l, _)| !l.starts_with("cohesive joints")));
+    }
+
+    #[test]
+    fn joint_model_without_wgsl_is_a_build_error_naming_it() {
+        let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        let s2 = split_nodes(&m2, &Range::All).unwrap();
+        let j = CohesiveJoints::new(s2.joints)
+            .model(Range::All, czm())
+            .model_for(vec![0], CpuOnly);
+        let err =
+            offline_kernel_sources::<_, CpuBackend>(&s2.mesh, vec![Box::new(j)], Precision::F64)
+                .unwrap_err();
+        assert!(matches!(err, ComputeError::NoGpuKernel { .. }), "{err:?}");
+        let msg = err.to_string();
+        assert!(
+            msg.contains("cpu-only-joint") && msg.contains("WGSL"),
+            "{msg}"
+        );
     }
 }

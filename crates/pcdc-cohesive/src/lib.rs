@@ -7,6 +7,11 @@
 //! the secant, softening lengths from G_f1 and G_f2), and node splitting
 //! ([`split_nodes`]) that gives the elements of FDEM regions their own nodes and puts a
 //! face-joint on every interior face.
+//!
+//! Joints run on both backends: [`CohesiveJoints`] has a GPU kernel into which each
+//! model's WGSL body ([`JointModel::wgsl`], [`WgslJointModel`]) is spliced; the built-in
+//! models provide one, and the softening curve uses the hand-written [`portable_exp`] on
+//! both backends so that f64 results agree to rounding.
 
 #![warn(missing_docs)]
 // Index loops mirror the tensor notation of the manual's equations.
@@ -22,7 +27,7 @@ pub use error::CohesiveError;
 pub use fractures::{joints_on_fractures, Distribution, Fracture, FractureNetwork};
 pub use joints::{CohesiveJoints, BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE};
 pub use model::{
-    czm_state, softening, softening_integral, FailureMode, IntrinsicCzm, JointModel,
-    MohrCoulombJoint, Traction, SOFTENING_A, SOFTENING_B, SOFTENING_C,
+    czm_state, portable_exp, softening, softening_integral, FailureMode, IntrinsicCzm, JointModel,
+    MohrCoulombJoint, Traction, WgslJointModel, SOFTENING_A, SOFTENING_B, SOFTENING_C,
 };
 pub use split::{split_nodes, Joints, SplitMesh};

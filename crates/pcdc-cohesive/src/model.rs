@@ -17,17 +17,94 @@ pub const SOFTENING_B: f64 = 1.8;
 /// See [`SOFTENING_A`].
 pub const SOFTENING_C: f64 = 6.0;
 
-/// Softening function f(D) of eq. 69: f(0) = 1, f(1) = 0, decreasing.
+/// (A + B − 1) / (A + B): the factor of the exponential in eq. 69.
+const SOFTENING_Z0: f64 = (SOFTENING_A + SOFTENING_B - 1.0) / (SOFTENING_A + SOFTENING_B);
+/// A + C B: numerator of the exponent in eq. 69 (multiplied by D).
+const SOFTENING_X: f64 = SOFTENING_A + SOFTENING_C * SOFTENING_B;
+/// (A + B)(1 − A − B): denominator of the exponent in eq. 69.
+const SOFTENING_Y: f64 = (SOFTENING_A + SOFTENING_B) * (1.0 - SOFTENING_A - SOFTENING_B);
+// f(D) takes (1 − D)^C by multiplications: C must stay 6.
+const _: () = assert!(SOFTENING_C == 6.0);
+
+/// Softening function f(D) of eq. 69: f(0) = 1, f(1) = 0, decreasing:
+/// f(D) = [1 − (A + B − 1)/(A + B) · exp(D (A + C B) / ((A + B)(1 − A − B)))]
+/// · [A (1 − D) + B (1 − D)^C].
+///
+/// Evaluated with + − × ÷ only ([`portable_exp`], and (1 − D)^6 as ((q²)(q²))q²), the
+/// same operations in the same order as the WGSL `softening` of the GPU joint kernel,
+/// so that both backends soften identically (f64 drivers often lack `exp`/`pow`).
 pub fn softening(d: f64) -> f64 {
-    let (a, b, c) = (SOFTENING_A, SOFTENING_B, SOFTENING_C);
     if d <= 0.0 {
         return 1.0;
     }
     if d >= 1.0 {
         return 0.0;
     }
-    let z = (a + b - 1.0) / (a + b) * (d * (a + c * b) / ((a + b) * (1.0 - a - b))).exp();
-    (1.0 - z) * (a * (1.0 - d) + b * (1.0 - d).powf(c))
+    let z = SOFTENING_Z0 * portable_exp(d * SOFTENING_X / SOFTENING_Y);
+    let q = 1.0 - d;
+    let q2 = q * q;
+    let q6 = q2 * q2 * q2;
+    (1.0 - z) * (SOFTENING_A * q + SOFTENING_B * q6)
+}
+
+/// ln 2, high part (fdlibm's `ln2HI` = 6.93147180369123816490e-01: its 21 trailing bits
+/// are zero, so `k · LN2_HI` is exact for |k| < 2^21).
+const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+/// ln 2 − `LN2_HI` (fdlibm's `ln2LO` = 1.90821492927058770002e-10).
+const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
+/// 1 / ln 2.
+const INV_LN2: f64 = std::f64::consts::LOG2_E;
+/// Taylor coefficients 1/i! of e^r, i = 0..=13.
+const EXP_TAYLOR: [f64; 14] = {
+    let mut c = [1.0; 14];
+    let mut i = 1;
+    while i < 14 {
+        c[i] = c[i - 1] / i as f64;
+        i += 1;
+    }
+    c
+};
+
+/// e^x with + − × ÷ and an integer conversion only: the argument is clamped to
+/// [−708, 709], reduced to x = k ln 2 + r with |r| ≤ ln 2 / 2 (Cody–Waite, two-part
+/// ln 2), e^r is a degree-13 Taylor polynomial in Horner form (truncation below 1e-17
+/// relative) and 2^k is exact. Within 4e-16 relative of `f64::exp` on the clamp range.
+///
+/// The WGSL function `portable_exp` of the joint kernel performs the same operations in
+/// the same order: GPU drivers often have no f64 `exp` (Vulkan's GLSL.std.450 `Exp` is
+/// 32-bit only), and a shared hand-written version keeps CPU and GPU results equal to
+/// rounding.
+pub fn portable_exp(x: f64) -> f64 {
+    let x = x.clamp(-708.0, 709.0);
+    let t = x * INV_LN2;
+    let k = (t + if t >= 0.0 { 0.5 } else { -0.5 }) as i32;
+    let kf = k as f64;
+    let r = (x - kf * LN2_HI) - kf * LN2_LO;
+    let mut p = EXP_TAYLOR[13];
+    for i in (0..13).rev() {
+        p = EXP_TAYLOR[i] + r * p;
+    }
+    // 2^k, k in [-1021, 1023]: a normal power of two, exact.
+    p * f64::from_bits(((k + 1023) as u64) << 52)
+}
+
+/// Constants the WGSL joint library (`portable_exp`, `softening`) reads, with their
+/// WGSL names: passed to the kernel as exact `Real` constants.
+pub(crate) fn wgsl_library_constants() -> Vec<(String, f64)> {
+    let mut c = vec![
+        ("SOFTENING_A".to_string(), SOFTENING_A),
+        ("SOFTENING_B".to_string(), SOFTENING_B),
+        ("SOFTENING_Z0".to_string(), SOFTENING_Z0),
+        ("SOFTENING_X".to_string(), SOFTENING_X),
+        ("SOFTENING_Y".to_string(), SOFTENING_Y),
+        ("LN2_HI".to_string(), LN2_HI),
+        ("LN2_LO".to_string(), LN2_LO),
+        ("INV_LN2".to_string(), INV_LN2),
+    ];
+    for (i, v) in EXP_TAYLOR.iter().enumerate() {
+        c.push((format!("EXP_C{i}"), *v));
+    }
+    c
 }
 
 /// ∫₀¹ f(D) dD (composite Simpson, 2000 intervals): the softening work per unit
@@ -122,6 +199,55 @@ pub trait JointModel: Send + Sync + std::fmt::Debug {
             0.0
         }
     }
+    /// The model's GPU code (a WGSL function body and its parameters, see
+    /// [`WgslJointModel`]). `None` (the default) means CPU only: building a GPU
+    /// simulation with such a model is an error that names it
+    /// ([`pcdc_compute::ComputeError::NoGpuKernel`]).
+    fn wgsl(&self) -> Option<WgslJointModel> {
+        None
+    }
+}
+
+/// A joint model's GPU code, spliced into the joint kernel template (the counterpart of
+/// `pcdc_mech::WgslModel` for [`JointModel`]).
+///
+/// `body` is the body of
+///
+/// ```text
+/// fn (o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32) -> JointTraction
+/// ```
+///
+/// with the arguments of [`JointModel::traction`]: the opening `o` (m), the slip vector
+/// `slip` (m, global components; `JointVec = array<Real, 3>`, components `D..3` are
+/// zero), the characteristic length `h` (m) and the history `(*state)[k]`
+/// (`JointState = array<Real, NSTATE>`, NSTATE ≥ [`JointModel::n_state`]: the largest
+/// history of the models composed). It returns
+///
+/// ```text
+/// struct JointTraction { normal: Real, shear: JointVec, damage: Real }
+/// ```
+///
+/// `normal` and `shear` as in [`Traction`] (Pa; shear components `D..3` are ignored) and
+/// `damage` = [`JointModel::damage`] of the updated state (≥ 1 marks the joint's faces
+/// broken). The body may read `param(p, k)` (= `params[k]`), the constant `D` (2 or 3),
+/// and call the library functions `portable_exp(x)` ([`portable_exp`]) and
+/// `softening(d)` ([`softening`], eq. 69). A fresh `var t: JointTraction;` is all
+/// zeros.
+///
+/// `Real` is `f64` or `f32` by precision: write literals without suffix, and wrap them
+/// in `Real(..)` where a `var` would otherwise default to f32 (`var x = Real(0.0);`).
+/// Keep to + − × ÷, `sqrt`, `abs`, `min`, `max`, `select` (drivers may lack f64
+/// `exp`/`pow`/`sin`; use `portable_exp`). To match the CPU to rounding, repeat the
+/// CPU's operations in the same order, and compute parameters such as tan φ on the host.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WgslJointModel {
+    /// Identifies the code: models with equal keys must have equal bodies (they share
+    /// one WGSL function and differ only in parameters).
+    pub key: String,
+    /// The WGSL function body.
+    pub body: String,
+    /// Parameters read with `param(p, k)`.
+    pub params: Vec<f64>,
 }
 
 /// Parameters of the intrinsic cohesive zone model (manual table 9, keyword
@@ -373,6 +499,25 @@ impl JointModel for IntrinsicCzm {
     fn damage(&self, state: &[f64]) -> f64 {
         state[czm_state::DAMAGE]
     }
+
+    /// Parameters: o_p/h, s_p/h, 1/o_t, 1/s_t, tan φ, T_s (Pa), c (Pa), P_overlap (Pa).
+    fn wgsl(&self) -> Option<WgslJointModel> {
+        let dv = self.derived.unwrap_or_else(|| self.derive());
+        Some(WgslJointModel {
+            key: "intrinsic_czm".into(),
+            body: include_str!("shaders/intrinsic_czm.wgsl").into(),
+            params: vec![
+                dv.op_h,
+                dv.sp_h,
+                dv.inv_ot,
+                dv.inv_st,
+                dv.tan_phi,
+                self.tensile_strength,
+                self.cohesion,
+                self.penalty_overlap,
+            ],
+        })
+    }
 }
 
 /// A pre-existing fracture (Mohr-Coulomb joint): no tensile strength, a normal penalty
@@ -481,6 +626,20 @@ impl JointModel for MohrCoulombJoint {
     fn is_broken(&self, _state: &[f64]) -> bool {
         true
     }
+
+    /// Parameters: P_n (Pa), P_t (Pa), c_r (Pa), tan φ.
+    fn wgsl(&self) -> Option<WgslJointModel> {
+        Some(WgslJointModel {
+            key: "joint_mohr_coulomb".into(),
+            body: include_str!("shaders/mohr_coulomb_joint.wgsl").into(),
+            params: vec![
+                self.penalty_normal,
+                self.penalty_shear,
+                self.cohesion,
+                self.friction_deg.to_radians().tan(),
+            ],
+        })
+    }
 }
 
 #[cfg(test)]
@@ -506,6 +665,34 @@ mod tests {
             prev = t;
         }
         w
+    }
+
+    #[test]
+    fn portable_exp_matches_libm() {
+        let mut worst = 0.0f64;
+        for i in 0..=200_000 {
+            let x = -708.0 + 1417.0 * i as f64 / 200_000.0;
+            let (a, b) = (portable_exp(x), x.exp());
+            worst = worst.max(((a - b) / b).abs());
+        }
+        for x in [0.0, 1e-300, -1e-300, 0.5, -0.5, 1.0, -3.3] {
+            let (a, b) = (portable_exp(x), f64::exp(x));
+            worst = worst.max(((a - b) / b).abs());
+        }
+        assert_eq!(portable_exp(0.0), 1.0);
+        assert!(worst < 4e-16, "largest relative error {worst:e}");
+    }
+
+    #[test]
+    fn softening_agrees_with_the_libm_formula() {
+        let (a, b, c) = (SOFTENING_A, SOFTENING_B, SOFTENING_C);
+        for i in 1..1000 {
+            let d = i as f64 / 1000.0;
+            let z = (a + b - 1.0) / (a + b) * (d * (a + c * b) / ((a + b) * (1.0 - a - b))).exp();
+            let libm = (1.0 - z) * (a * (1.0 - d) + b * (1.0 - d).powf(c));
+            let f = softening(d);
+            assert!((f - libm).abs() <= 2e-15, "f({d}) = {f} vs {libm}");
+        }
     }
 
     #[test]
