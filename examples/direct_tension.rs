@@ -11,8 +11,8 @@
 //! `--precision f64|f32` (default f64 where the adapter supports it, or
 //! `PCDC_PRECISION`); the RESULT line carries `backend=` and `precision=`, e.g.
 //! `cargo run --release --example direct_tension -- --backend gpu --precision f32`.
-//! Cohesive joints have no GPU kernel yet, so on the GPU this example stops at the build with a
-//! `cannot run on the GPU backend` error (exit status 1).
+//! Elements, joints and boundary conditions all run on the device; on lavapipe (software
+//! Vulkan) the full-size run is slow: it proves the path, not GPU speed.
 
 use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
 use pcdc::plot::Plot;
