@@ -176,11 +176,11 @@ pub fn run<B: Backend>(backend: &B, p: &Params, solver: Solver) -> Result<Outcom
             check_every: 1,
         })?,
         Solver::Relaxation => sim.relax(&StaticOptions {
-            // In f32 the unbalanced-force ratio levels off near 1e-5 (forces are sums of
-            // element forces that cancel to ~1e-7 of their size), so ask for what f32
-            // can deliver; its larger stress error is then reported as measured.
+            // f32 forces carry ~1e-7 relative noise, which the unbalanced-force ratio
+            // (net over gross) sees amplified; 1e-5 is safely reachable in f32, and the
+            // f32 stress error is then reported as measured.
             tolerance: if backend.precision() == "f32" {
-                1e-4
+                1e-5
             } else {
                 1e-6
             },
