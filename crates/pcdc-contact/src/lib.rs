@@ -12,5 +12,5 @@
 mod physics;
 mod potential2d;
 
-pub use physics::{Contact, Friction, CONTACT_REFERENCE};
+pub use physics::{Contact, ContactDamping, Friction, CONTACT_REFERENCE};
 pub use potential2d::{potential, triangle_pair_force, PairForce2};

@@ -10,9 +10,12 @@
 //! exactly and no atomics are needed. Elements sharing a node (one continuous body)
 //! do not contact each other.
 //!
-//! Limitations of this first version: 2D only, normal force only (no friction or
-//! damping yet), and no exclusion of neighbours bonded by intact cohesive joints, so it
-//! is meant for separate bodies.
+//! Per pair the physics keeps three history values, carried across rebuilds and
+//! snapshots: the accumulated slip δ_s of the friction law (eq. 59-60) and, for contact
+//! damping (eq. 61), the largest trial normal stress reached and the stress held there.
+//!
+//! Limitations: 2D only and no exclusion of neighbours bonded by intact cohesive joints,
+//! so it is meant for separate bodies.
 
 use std::sync::Mutex;
 
@@ -90,17 +93,68 @@ fn add_friction<D: Dim>(
     }
 }
 
+/// History values per pair: slip δ_s (m), largest trial normal stress σ_try,max (Pa),
+/// normal stress held at that point σ_max (Pa).
+const PAIR_STATE: usize = 3;
+
+/// Contact damping after An and Tannant (2007), manual eq. 61.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactDamping {
+    /// Damping transition stress T (Pa): the loading normal stress is capped at T.
+    pub transition: f64,
+    /// Damping exponent b (≥ 1): unloading follows σ_max (o_n / o_n,max)^b.
+    pub exponent: f64,
+}
+
+/// Applies eq. 61 to a pair's normal forces. The contact stress is σ_try = |F_n| / h
+/// (h the contact length, per unit thickness) and the overlap is taken proportional to
+/// it (o_n = σ_try / P_n for the penalty law), so o_n / o_n,max = σ_try / σ_try,max.
+/// Loading (σ_try at its maximum so far): σ = min(σ_try, T), remembered as σ_max.
+/// Unloading or reloading below the maximum: σ = σ_max (o_n / o_n,max)^b. With b = 1 and
+/// T above every σ_try this is the undamped law; b > 1 dissipates energy each contact
+/// cycle. The history resets when the pair separates. The manual writes T in the
+/// unloading branch; starting the power curve from the stress actually reached keeps the
+/// force continuous when σ_try stays below T (the two agree when the cap is reached).
+fn apply_damping(pair: &mut crate::PairForce2, d: ContactDamping, h: f64, state: &mut [f64]) {
+    let fc = [
+        pair.contactor.iter().map(|v| v[0]).sum::<f64>(),
+        pair.contactor.iter().map(|v| v[1]).sum::<f64>(),
+    ];
+    let fn_mag = (fc[0] * fc[0] + fc[1] * fc[1]).sqrt();
+    if fn_mag == 0.0 {
+        state[1] = 0.0;
+        state[2] = 0.0;
+        return;
+    }
+    let s_try = fn_mag / h;
+    let s = if s_try >= state[1] {
+        state[1] = s_try;
+        state[2] = s_try.min(d.transition);
+        state[2]
+    } else {
+        state[2] * (s_try / state[1]).powf(d.exponent)
+    };
+    let scale = s / s_try;
+    for a in 0..3 {
+        for k in 0..2 {
+            pair.contactor[a][k] *= scale;
+            pair.target[a][k] *= scale;
+        }
+    }
+}
+
 /// Potential contact between all elements of the mesh (2D).
 #[derive(Debug)]
 pub struct Contact {
     penalty: f64,
     friction: Option<Friction>,
+    damping: Option<ContactDamping>,
     skin: Option<f64>,
     skin_used: f64,
     reference: Option<FieldId>,
     candidates: Mutex<Vec<Vec<u32>>>,
-    /// Accumulated tangential slip δ_s (m) per element and candidate (same order as the
-    /// candidate lists); both elements of a pair update identical copies.
+    /// Pair history per element and candidate (same order as the candidate lists),
+    /// [`PAIR_STATE`] values each; both elements of a pair update identical copies.
     slips: Mutex<Vec<Vec<f64>>>,
 }
 
@@ -120,6 +174,7 @@ impl Contact {
         Contact {
             penalty,
             friction: None,
+            damping: None,
             skin: None,
             skin_used: 0.0,
             reference: None,
@@ -133,6 +188,16 @@ impl Contact {
         self.friction = Some(Friction {
             angle_deg,
             penalty: shear_penalty,
+        });
+        self
+    }
+
+    /// Adds contact damping (eq. 61, keywords `damping-t` and `damping-b` of table 8):
+    /// transition stress T (Pa) and exponent b (≥ 1).
+    pub fn damping(mut self, transition: f64, exponent: f64) -> Self {
+        self.damping = Some(ContactDamping {
+            transition,
+            exponent,
         });
         self
     }
@@ -269,6 +334,22 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
                 ));
             }
         }
+        if let Some(d) = self.damping {
+            if d.transition.is_nan() || d.transition <= 0.0 {
+                return Err(ComputeError::param(
+                    "contact damping transition stress T",
+                    d.transition,
+                    "must be positive (Pa)",
+                ));
+            }
+            if !(d.exponent >= 1.0 && d.exponent.is_finite()) {
+                return Err(ComputeError::param(
+                    "contact damping exponent b",
+                    d.exponent,
+                    "must be finite and at least 1 (b < 1 would create energy on unloading)",
+                ));
+            }
+        }
         let (lo, _) = ctx.mesh.edge_length_range();
         self.skin_used = self.skin.unwrap_or(0.5 * lo);
         if !(self.skin_used > 0.0 && self.skin_used.is_finite()) {
@@ -284,8 +365,8 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
     }
 
     fn save_state(&self) -> Result<Vec<u8>, ComputeError> {
-        // Candidate lists and accumulated slips, little-endian: count, then per element
-        // its list length, partners (u32) and slips (f64).
+        // Candidate lists and pair histories, little-endian: count, then per element its
+        // list length, partners (u32) and PAIR_STATE values per partner (f64).
         let poisoned = || ComputeError::physics("contact", "state poisoned by an earlier panic");
         let cand = self.candidates.lock().map_err(|_| poisoned())?;
         let slips = self.slips.lock().map_err(|_| poisoned())?;
@@ -299,7 +380,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
             for f in list {
                 out.extend_from_slice(&f.to_le_bytes());
             }
-            for k in 0..list.len() {
+            for k in 0..list.len() * PAIR_STATE {
                 out.extend_from_slice(&slip.get(k).copied().unwrap_or(0.0).to_le_bytes());
             }
         }
@@ -327,7 +408,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
             let list: Vec<u32> = (0..len)
                 .map(|_| take(4).map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes"))))
                 .collect::<Result<_, _>>()?;
-            let slip: Vec<f64> = (0..len)
+            let slip: Vec<f64> = (0..len * PAIR_STATE)
                 .map(|_| take(8).map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes"))))
                 .collect::<Result<_, _>>()?;
             cand.push(list);
@@ -377,12 +458,17 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         if moved || cand.len() != kin.mesh.n_elements() {
             let fresh = ctx.backend.install(|| self.build(kin));
             // Carry the accumulated slip of pairs that stay candidates.
-            let mut new_slips: Vec<Vec<f64>> = fresh.iter().map(|l| vec![0.0; l.len()]).collect();
+            let mut new_slips: Vec<Vec<f64>> = fresh
+                .iter()
+                .map(|l| vec![0.0; l.len() * PAIR_STATE])
+                .collect();
             if slips.len() == cand.len() {
                 for e in 0..fresh.len().min(cand.len()) {
                     for (k, f) in fresh[e].iter().enumerate() {
                         if let Ok(old) = cand[e].binary_search(f) {
-                            new_slips[e][k] = slips[e][old];
+                            new_slips[e][k * PAIR_STATE..(k + 1) * PAIR_STATE].copy_from_slice(
+                                &slips[e][old * PAIR_STATE..(old + 1) * PAIR_STATE],
+                            );
                         }
                     }
                 }
@@ -398,6 +484,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         let slips: &mut Vec<Vec<f64>> = &mut slips;
         let penalty = self.penalty;
         let friction = self.friction;
+        let damping = self.damping;
         let mean_edge = |e: usize| {
             let t = Self::element_xy(kin, e);
             (0..3)
@@ -425,9 +512,15 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
                             (&other, &me, f, e)
                         };
                         let mut pair = triangle_pair_force(c, t, penalty);
-                        if let Some(fr) = friction {
+                        let state = &mut slip[k * PAIR_STATE..(k + 1) * PAIR_STATE];
+                        if friction.is_some() || damping.is_some() {
                             let h = 0.5 * (mean_edge(ci) + mean_edge(ti));
-                            add_friction(&mut pair, kin, ci, ti, fr, h, &mut slip[k]);
+                            if let Some(d) = damping {
+                                apply_damping(&mut pair, d, h, state);
+                            }
+                            if let Some(fr) = friction {
+                                add_friction(&mut pair, kin, ci, ti, fr, h, &mut state[0]);
+                            }
                         }
                         let share = if e < f { pair.contactor } else { pair.target };
                         for a in 0..3 {
@@ -448,6 +541,37 @@ mod tests {
     use proptest::prelude::*;
 
     proptest! {
+        /// Contact damping (eq. 61) never raises the force above the undamped one, never
+        /// above T h, keeps its direction, and is the identity for b = 1 with T out of reach.
+        #[test]
+        fn damping_bounded_and_passive(stresses in proptest::collection::vec(0.0f64..1e7, 1..40),
+                                       t in 1e5f64..1e7, b in 1.0f64..5.0, h in 0.01f64..0.1) {
+            let mut state = [0.0; PAIR_STATE];
+            let mut ident = [0.0; PAIR_STATE];
+            for &s_try in &stresses {
+                // A pair whose normal force is s_try h along (0.6, 0.8), split over nodes.
+                let f = s_try * h;
+                let mk = || crate::PairForce2 {
+                    contactor: [[0.6 * f * 0.5, 0.8 * f * 0.5], [0.6 * f * 0.3, 0.8 * f * 0.3], [0.6 * f * 0.2, 0.8 * f * 0.2]],
+                    target: [[-0.6 * f * 0.4, -0.8 * f * 0.4], [-0.6 * f * 0.4, -0.8 * f * 0.4], [-0.6 * f * 0.2, -0.8 * f * 0.2]],
+                };
+                let mut p = mk();
+                apply_damping(&mut p, ContactDamping { transition: t, exponent: b }, h, &mut state);
+                let fx: f64 = p.contactor.iter().map(|v| v[0]).sum();
+                let fy: f64 = p.contactor.iter().map(|v| v[1]).sum();
+                let mag = (fx * fx + fy * fy).sqrt();
+                prop_assert!(mag <= f * (1.0 + 1e-12) + 1e-300);
+                prop_assert!(mag <= t * h * (1.0 + 1e-12));
+                prop_assert!(fx >= 0.0 && fy >= 0.0);
+                let tx: f64 = p.target.iter().map(|v| v[0]).sum();
+                prop_assert!((tx + fx).abs() <= 1e-9 * f.max(1e-300));
+                let mut q = mk();
+                apply_damping(&mut q, ContactDamping { transition: 1e300, exponent: 1.0 }, h, &mut ident);
+                let qx: f64 = q.contactor.iter().map(|v| v[0]).sum();
+                prop_assert!((qx - 0.6 * f).abs() <= 1e-12 * f + 1e-300);
+            }
+        }
+
         /// Friction never exceeds tan φ times the normal force, and once sliding it
         /// opposes the relative sliding velocity of the contactor.
         #[test]
