@@ -14,8 +14,11 @@
 //! snapshots: the accumulated slip δ_s of the friction law (eq. 59-60) and, for contact
 //! damping (eq. 61), the largest trial normal stress reached and the stress held there.
 //!
-//! Limitations: 2D only and no exclusion of neighbours bonded by intact cohesive joints,
-//! so it is meant for separate bodies.
+//! Elements bonded by an intact cohesive joint do not contact each other once the bonds
+//! are declared with [`Contact::bonded_pairs`]; the pair becomes a contact pair as soon
+//! as the joint's broken-face flag is set (the cohesive crate publishes it).
+//!
+//! Limitations: 2D only.
 
 use std::sync::Mutex;
 
@@ -150,12 +153,38 @@ pub struct Contact {
     friction: Option<Friction>,
     damping: Option<ContactDamping>,
     skin: Option<f64>,
+    bonds: Option<Bonds>,
     skin_used: f64,
     reference: Option<FieldId>,
     candidates: Mutex<Vec<Vec<u32>>>,
     /// Pair history per element and candidate (same order as the candidate lists),
     /// [`PAIR_STATE`] values each; both elements of a pair update identical copies.
     slips: Mutex<Vec<Vec<f64>>>,
+}
+
+/// Element pairs bonded through a face (e.g. by a cohesive joint) and the face field
+/// that says when the bond is broken.
+#[derive(Clone, Debug)]
+struct Bonds {
+    /// Elements of each bond, stride 2.
+    elements: Vec<u32>,
+    /// One face of each bond.
+    faces: Vec<u32>,
+    /// Name of the face field: 0 = bonded (no contact), non-zero = broken (contact).
+    field: String,
+    id: Option<FieldId>,
+    /// Per element: (bonded neighbour, face), sorted by neighbour.
+    per_element: Vec<Vec<(u32, u32)>>,
+}
+
+impl Bonds {
+    /// The bond face between elements `e` and `f`, if they are bonded.
+    fn face(&self, e: usize, f: usize) -> Option<usize> {
+        let list = &self.per_element[e];
+        list.binary_search_by_key(&(f as u32), |b| b.0)
+            .ok()
+            .map(|i| list[i].1 as usize)
+    }
 }
 
 /// Coulomb friction with a shear penalty (manual eq. 59-60).
@@ -176,6 +205,7 @@ impl Contact {
             friction: None,
             damping: None,
             skin: None,
+            bonds: None,
             skin_used: 0.0,
             reference: None,
             candidates: Mutex::new(Vec::new()),
@@ -198,6 +228,24 @@ impl Contact {
         self.damping = Some(ContactDamping {
             transition,
             exponent,
+        });
+        self
+    }
+
+    /// Declares bonded element pairs that must not contact each other while bonded:
+    /// `elements` holds the two elements of each bond (stride 2), `faces` one face per bond
+    /// (the bond's face on either side), and `broken_field` names a face field that is 0
+    /// while the bond holds and non-zero once it is broken. For FDEM regions from
+    /// `pcdc_cohesive::split_nodes`: `joints.elements`, every other entry of
+    /// `joints.faces`, and `pcdc_cohesive::BROKEN_FACE`, so broken joint faces become
+    /// contact faces.
+    pub fn bonded_pairs(mut self, elements: &[u32], faces: &[u32], broken_field: &str) -> Self {
+        self.bonds = Some(Bonds {
+            elements: elements.to_vec(),
+            faces: faces.to_vec(),
+            field: broken_field.to_string(),
+            id: None,
+            per_element: Vec::new(),
         });
         self
     }
@@ -359,6 +407,48 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
                 "must be positive and finite",
             ));
         }
+        if let Some(b) = &mut self.bonds {
+            let (ne, nf) = (ctx.mesh.n_elements(), ctx.mesh.faces().len());
+            if b.elements.len() % 2 != 0 || b.elements.len() / 2 != b.faces.len() {
+                return Err(ComputeError::param(
+                    "contact bonded pairs",
+                    format!("{} elements, {} faces", b.elements.len(), b.faces.len()),
+                    "give two elements and one face per bond",
+                ));
+            }
+            if let Some(&e) = b.elements.iter().find(|&&e| e as usize >= ne) {
+                return Err(ComputeError::param(
+                    "contact bonded element",
+                    e,
+                    format!("mesh has {ne} elements"),
+                ));
+            }
+            if let Some(&f) = b.faces.iter().find(|&&f| f as usize >= nf) {
+                return Err(ComputeError::param(
+                    "contact bonded face",
+                    f,
+                    format!("mesh has {nf} faces"),
+                ));
+            }
+            let id = ctx.fields.id(&b.field)?;
+            if ctx.fields.get(id).len() != nf {
+                return Err(ComputeError::param(
+                    "contact broken-bond field",
+                    &b.field,
+                    "must be a face field with one value per face",
+                ));
+            }
+            b.id = Some(id);
+            let mut per = vec![Vec::new(); ne];
+            for (i, pair) in b.elements.chunks_exact(2).enumerate() {
+                per[pair[0] as usize].push((pair[1], b.faces[i]));
+                per[pair[1] as usize].push((pair[0], b.faces[i]));
+            }
+            for l in &mut per {
+                l.sort_unstable();
+            }
+            b.per_element = per;
+        }
         self.reference = Some(ctx.fields.id(CONTACT_REFERENCE)?);
         ctx.register_slots(ctx.mesh.elements())?;
         Ok(())
@@ -485,6 +575,11 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         let penalty = self.penalty;
         let friction = self.friction;
         let damping = self.damping;
+        let bonds = self.bonds.as_ref();
+        let broken: &[f64] = match bonds.and_then(|b| b.id) {
+            Some(id) => ctx.fields.get(id),
+            None => &[],
+        };
         let mean_edge = |e: usize| {
             let t = Self::element_xy(kin, e);
             (0..3)
@@ -504,6 +599,12 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
                     let me = Self::element_xy(kin, e);
                     for (k, &f) in lists[e].iter().enumerate() {
                         let f = f as usize;
+                        // Bonded neighbours interact through their joint until it breaks.
+                        if let Some(face) = bonds.and_then(|b| b.face(e, f)) {
+                            if broken[face] == 0.0 {
+                                continue;
+                            }
+                        }
                         let other = Self::element_xy(kin, f);
                         // Canonical order: the lower index is the contactor.
                         let (c, t, ci, ti) = if e < f {

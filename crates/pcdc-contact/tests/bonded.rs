@@ -1,0 +1,98 @@
+//! Elements bonded through a face (a cohesive joint in FDEM regions) do not contact each
+//! other until the bond's broken flag is set; then the pair pushes apart.
+
+use pcdc_compute::{
+    ComputeError, CpuBackend, FieldSpec, ForceContext, InitContext, Location, Physics, Simulation,
+};
+use pcdc_contact::Contact;
+use pcdc_mech::{LinearElastic, Mechanics};
+use pcdc_mesh::{Dim2, Mesh, Range};
+
+const FLAG: &str = "bond_broken";
+
+/// Declares the broken-bond face field (what pcdc-cohesive publishes as `broken_face`).
+struct BondFlags;
+
+impl Physics<Dim2> for BondFlags {
+    fn name(&self) -> &str {
+        "bond flags"
+    }
+    fn fields(&self, _mesh: &Mesh<Dim2>) -> Vec<FieldSpec> {
+        vec![FieldSpec::new(FLAG, Location::Face, 1)]
+    }
+    fn init(&mut self, _ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
+        Ok(())
+    }
+    fn compute_forces(
+        &self,
+        _ctx: &mut ForceContext<'_, Dim2, CpuBackend>,
+    ) -> Result<(), ComputeError> {
+        Ok(())
+    }
+}
+
+/// Two triangles of a unit square, each with its own nodes, overlapping across their
+/// common diagonal after B is pushed into A.
+fn scene(contact: bool) -> (Simulation<Dim2>, u32) {
+    let coords = vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0];
+    let mesh = Mesh::<Dim2>::new(coords, vec![0, 1, 2, 3, 4, 5]).unwrap();
+    let face = (0..mesh.faces().len() as u32)
+        .find(|&f| {
+            let n = mesh.face(f as usize);
+            n.contains(&1) && n.contains(&2)
+        })
+        .unwrap();
+    let rock = LinearElastic::new(1e9, 0.25, 1000.0).unwrap();
+    let mut b = Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(BondFlags);
+    if contact {
+        b = b.physics(Contact::new(1e10).bonded_pairs(&[0, 1], &[face], FLAG));
+    }
+    let mut sim = b.build().unwrap();
+    for n in 3..6 {
+        sim.state.u[2 * n] = -0.05;
+        sim.state.u[2 * n + 1] = -0.05;
+    }
+    (sim, face)
+}
+
+#[test]
+fn bonded_pair_has_no_contact_until_broken() {
+    let (mut plain, _) = scene(false);
+    let f_plain = plain.evaluate_forces().unwrap().to_vec();
+    let (mut sim, face) = scene(true);
+    let f_bonded = sim.evaluate_forces().unwrap().to_vec();
+    assert_eq!(f_plain, f_bonded, "an intact bond must hide the contact");
+    let id = sim.state.fields.id(FLAG).unwrap();
+    sim.state.fields.get_mut(id)[face as usize] = 1.0;
+    let f_broken = sim.evaluate_forces().unwrap().to_vec();
+    // Contact pushes B (nodes 3-5) back along +x+y, and A the opposite way.
+    let push_b: f64 = (3..6).map(|n| f_broken[2 * n] - f_plain[2 * n]).sum();
+    let push_a: f64 = (0..3).map(|n| f_broken[2 * n] - f_plain[2 * n]).sum();
+    assert!(push_b > 0.0, "broken bond: contact force on B {push_b}");
+    assert!(
+        (push_a + push_b).abs() <= 1e-9 * push_b,
+        "action = reaction: {push_a} vs {push_b}"
+    );
+}
+
+#[test]
+fn bad_bond_input_is_an_error() {
+    let coords = vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0];
+    let mesh = Mesh::<Dim2>::new(coords, vec![0, 1, 2, 3, 4, 5]).unwrap();
+    let rock = LinearElastic::new(1e9, 0.25, 1000.0).unwrap();
+    for (el, fa, field) in [
+        (vec![0, 1], vec![99], FLAG),
+        (vec![0, 7], vec![0], FLAG),
+        (vec![0, 1, 1], vec![0], FLAG),
+        (vec![0, 1], vec![0], "no_such_field"),
+    ] {
+        let r = Simulation::builder(mesh.clone(), CpuBackend::new(1).unwrap())
+            .physics(Mechanics::new().material(Range::All, rock.clone()))
+            .physics(BondFlags)
+            .physics(Contact::new(1e10).bonded_pairs(&el, &fa, field))
+            .build();
+        assert!(r.is_err(), "{el:?} {fa:?} {field} accepted");
+    }
+}
