@@ -29,24 +29,27 @@ use pcdc_compute::{
 use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;
 
+use std::sync::Arc;
+
+use crate::model::{ContactDamping, ContactModel, Friction, MohrCoulombContact};
 use crate::triangle_pair_force;
 
 /// Node positions at the last broad-phase build (m), stride D.
 pub const CONTACT_REFERENCE: &str = "contact_reference_positions";
 
-/// Adds the Coulomb friction of eq. 59-60 to a pair's normal forces: the tangential
-/// force `min(k_t |δ_s|, tan φ |F_n|)` opposes the accumulated slip δ_s (which grows with
-/// the relative sliding velocity and is reset to the Coulomb limit when sliding, eq. 60),
-/// with `k_t = P_t h²`. It is distributed over each triangle's nodes in proportion to
-/// that triangle's share of the normal force (equal and opposite totals).
-fn add_friction<D: Dim>(
+/// Applies the contact law to a pair's normal (potential) forces: trial stress
+/// σ_try = |F_n| / h, slip increment from the relative tangential velocity of the two
+/// triangles (node velocities weighted by each node's share of the normal force), then
+/// the normal forces are scaled to σ_n h and the shear force τ h is added along the
+/// tangent with the same weights, equal and opposite on the two triangles.
+fn apply_model<D: Dim>(
     pair: &mut crate::PairForce2,
     kin: &Kinematics<'_, D>,
     c: usize,
     t: usize,
-    fr: Friction,
+    model: &dyn ContactModel,
     h: f64,
-    slip: &mut f64,
+    state: &mut [f64],
 ) {
     let fc = [
         pair.contactor.iter().map(|v| v[0]).sum::<f64>(),
@@ -54,7 +57,7 @@ fn add_friction<D: Dim>(
     ];
     let fn_mag = (fc[0] * fc[0] + fc[1] * fc[1]).sqrt();
     if fn_mag == 0.0 {
-        *slip = 0.0;
+        model.separate(state);
         return;
     }
     let n = [fc[0] / fn_mag, fc[1] / fn_mag];
@@ -79,69 +82,24 @@ fn add_friction<D: Dim>(
     };
     let (vc, vt) = (vel(c, &wc), vel(t, &wt));
     let v_rel = (vc[0] - vt[0]) * tang[0] + (vc[1] - vt[1]) * tang[1];
-    *slip += v_rel * kin.dt;
-    let kt = fr.penalty * h * h;
-    let limit = fr.angle_deg.to_radians().tan() * fn_mag;
-    let mut ft = kt * slip.abs();
-    if ft > limit {
-        ft = limit;
-        *slip = slip.signum() * limit / kt;
-    }
-    let ft = -slip.signum() * ft;
-    for a in 0..3 {
-        for d in 0..2 {
-            pair.contactor[a][d] += wc[a] * ft * tang[d];
-            pair.target[a][d] -= wt[a] * ft * tang[d];
+    let s_try = fn_mag / h;
+    let r = model.update(s_try, v_rel * kin.dt, h, state);
+    if r.normal != s_try {
+        let scale = r.normal / s_try;
+        for a in 0..3 {
+            for k in 0..2 {
+                pair.contactor[a][k] *= scale;
+                pair.target[a][k] *= scale;
+            }
         }
     }
-}
-
-/// History values per pair: slip δ_s (m), largest trial normal stress σ_try,max (Pa),
-/// normal stress held at that point σ_max (Pa).
-const PAIR_STATE: usize = 3;
-
-/// Contact damping after An and Tannant (2007), manual eq. 61.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ContactDamping {
-    /// Damping transition stress T (Pa): the loading normal stress is capped at T.
-    pub transition: f64,
-    /// Damping exponent b (≥ 1): unloading follows σ_max (o_n / o_n,max)^b.
-    pub exponent: f64,
-}
-
-/// Applies eq. 61 to a pair's normal forces. The contact stress is σ_try = |F_n| / h
-/// (h the contact length, per unit thickness) and the overlap is taken proportional to
-/// it (o_n = σ_try / P_n for the penalty law), so o_n / o_n,max = σ_try / σ_try,max.
-/// Loading (σ_try at its maximum so far): σ = min(σ_try, T), remembered as σ_max.
-/// Unloading or reloading below the maximum: σ = σ_max (o_n / o_n,max)^b. With b = 1 and
-/// T above every σ_try this is the undamped law; b > 1 dissipates energy each contact
-/// cycle. The history resets when the pair separates. The manual writes T in the
-/// unloading branch; starting the power curve from the stress actually reached keeps the
-/// force continuous when σ_try stays below T (the two agree when the cap is reached).
-fn apply_damping(pair: &mut crate::PairForce2, d: ContactDamping, h: f64, state: &mut [f64]) {
-    let fc = [
-        pair.contactor.iter().map(|v| v[0]).sum::<f64>(),
-        pair.contactor.iter().map(|v| v[1]).sum::<f64>(),
-    ];
-    let fn_mag = (fc[0] * fc[0] + fc[1] * fc[1]).sqrt();
-    if fn_mag == 0.0 {
-        state[1] = 0.0;
-        state[2] = 0.0;
-        return;
-    }
-    let s_try = fn_mag / h;
-    let s = if s_try >= state[1] {
-        state[1] = s_try;
-        state[2] = s_try.min(d.transition);
-        state[2]
-    } else {
-        state[2] * (s_try / state[1]).powf(d.exponent)
-    };
-    let scale = s / s_try;
-    for a in 0..3 {
-        for k in 0..2 {
-            pair.contactor[a][k] *= scale;
-            pair.target[a][k] *= scale;
+    if r.shear != 0.0 {
+        let ft = r.shear * h;
+        for a in 0..3 {
+            for d in 0..2 {
+                pair.contactor[a][d] += wc[a] * ft * tang[d];
+                pair.target[a][d] -= wt[a] * ft * tang[d];
+            }
         }
     }
 }
@@ -152,13 +110,17 @@ pub struct Contact {
     penalty: f64,
     friction: Option<Friction>,
     damping: Option<ContactDamping>,
+    custom: Option<Arc<dyn ContactModel>>,
+    /// The law in force (set by init): the custom model or `contact-m-c`.
+    model: Option<Arc<dyn ContactModel>>,
+    n_state: usize,
     skin: Option<f64>,
     bonds: Option<Bonds>,
     skin_used: f64,
     reference: Option<FieldId>,
     candidates: Mutex<Vec<Vec<u32>>>,
     /// Pair history per element and candidate (same order as the candidate lists),
-    /// [`PAIR_STATE`] values each; both elements of a pair update identical copies.
+    /// `n_state` values each; both elements of a pair update identical copies.
     slips: Mutex<Vec<Vec<f64>>>,
 }
 
@@ -187,16 +149,6 @@ impl Bonds {
     }
 }
 
-/// Coulomb friction with a shear penalty (manual eq. 59-60).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Friction {
-    /// Friction angle φ (degrees).
-    pub angle_deg: f64,
-    /// Shear penalty P_t (Pa/m): the tangential stiffness of a contact of length h is
-    /// P_t h² (N/m per unit thickness), h the mean edge length of the two elements.
-    pub penalty: f64,
-}
-
 impl Contact {
     /// Contact with normal penalty `penalty` (Pa; the manual's default is 10 E).
     pub fn new(penalty: f64) -> Self {
@@ -204,6 +156,9 @@ impl Contact {
             penalty,
             friction: None,
             damping: None,
+            custom: None,
+            model: None,
+            n_state: 0,
             skin: None,
             bonds: None,
             skin_used: 0.0,
@@ -211,6 +166,13 @@ impl Contact {
             candidates: Mutex::new(Vec::new()),
             slips: Mutex::new(Vec::new()),
         }
+    }
+
+    /// Uses a user contact law instead of the built-in `contact-m-c` (its normal penalty
+    /// replaces the one given to [`Contact::new`]; `friction` and `damping` are ignored).
+    pub fn with_model(mut self, model: impl ContactModel + 'static) -> Self {
+        self.custom = Some(Arc::new(model));
+        self
     }
 
     /// Adds Coulomb friction (eq. 59-60).
@@ -359,45 +321,17 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
                 "3D contact (tetrahedra) is not implemented yet",
             ));
         }
-        if !(self.penalty > 0.0 && self.penalty.is_finite()) {
-            return Err(ComputeError::param(
-                "contact penalty",
-                self.penalty,
-                "must be positive and finite",
-            ));
-        }
-        if let Some(f) = self.friction {
-            if !(0.0..90.0).contains(&f.angle_deg) {
-                return Err(ComputeError::param(
-                    "contact friction angle",
-                    f.angle_deg,
-                    "must lie in [0, 90) degrees",
-                ));
-            }
-            if !(f.penalty > 0.0 && f.penalty.is_finite()) {
-                return Err(ComputeError::param(
-                    "contact shear penalty",
-                    f.penalty,
-                    "must be positive and finite",
-                ));
-            }
-        }
-        if let Some(d) = self.damping {
-            if d.transition.is_nan() || d.transition <= 0.0 {
-                return Err(ComputeError::param(
-                    "contact damping transition stress T",
-                    d.transition,
-                    "must be positive (Pa)",
-                ));
-            }
-            if !(d.exponent >= 1.0 && d.exponent.is_finite()) {
-                return Err(ComputeError::param(
-                    "contact damping exponent b",
-                    d.exponent,
-                    "must be finite and at least 1 (b < 1 would create energy on unloading)",
-                ));
-            }
-        }
+        let model: Arc<dyn ContactModel> = match &self.custom {
+            Some(m) => m.clone(),
+            None => Arc::new(MohrCoulombContact {
+                normal_penalty: self.penalty,
+                friction: self.friction,
+                damping: self.damping,
+            }),
+        };
+        model.check()?;
+        self.n_state = model.n_state();
+        self.model = Some(model);
         let (lo, _) = ctx.mesh.edge_length_range();
         self.skin_used = self.skin.unwrap_or(0.5 * lo);
         if !(self.skin_used > 0.0 && self.skin_used.is_finite()) {
@@ -456,7 +390,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
 
     fn save_state(&self) -> Result<Vec<u8>, ComputeError> {
         // Candidate lists and pair histories, little-endian: count, then per element its
-        // list length, partners (u32) and PAIR_STATE values per partner (f64).
+        // list length, partners (u32) and n_state values per partner (f64).
         let poisoned = || ComputeError::physics("contact", "state poisoned by an earlier panic");
         let cand = self.candidates.lock().map_err(|_| poisoned())?;
         let slips = self.slips.lock().map_err(|_| poisoned())?;
@@ -470,7 +404,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
             for f in list {
                 out.extend_from_slice(&f.to_le_bytes());
             }
-            for k in 0..list.len() * PAIR_STATE {
+            for k in 0..list.len() * self.n_state {
                 out.extend_from_slice(&slip.get(k).copied().unwrap_or(0.0).to_le_bytes());
             }
         }
@@ -498,7 +432,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
             let list: Vec<u32> = (0..len)
                 .map(|_| take(4).map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes"))))
                 .collect::<Result<_, _>>()?;
-            let slip: Vec<f64> = (0..len * PAIR_STATE)
+            let slip: Vec<f64> = (0..len * self.n_state)
                 .map(|_| take(8).map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes"))))
                 .collect::<Result<_, _>>()?;
             cand.push(list);
@@ -512,9 +446,13 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
     fn stable_step(&self, kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
         // A node pushed by the potential of a neighbour's sub-triangle (gradient 3/h over
         // an edge of length ~h) sees a stiffness of about 3 p per unit thickness.
+        let penalty = self
+            .model
+            .as_ref()
+            .map_or(self.penalty, |m| m.normal_penalty());
         let (mut best, mut which) = (f64::INFINITY, 0);
         for (n, &m) in kin.mass.iter().enumerate() {
-            let dt = 2.0 * (m / (2.0 * 3.0 * self.penalty)).sqrt();
+            let dt = 2.0 * (m / (2.0 * 3.0 * penalty)).sqrt();
             if dt < best {
                 best = dt;
                 which = n;
@@ -529,6 +467,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
 
     fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
         let rid = self.reference.expect("init ran");
+        let ns = self.n_state;
         let kin = &ctx.kin;
         let reference = ctx.fields.get_mut(rid);
         // Rebuild when any node moved more than half the skin since the last build.
@@ -548,17 +487,14 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         if moved || cand.len() != kin.mesh.n_elements() {
             let fresh = ctx.backend.install(|| self.build(kin));
             // Carry the accumulated slip of pairs that stay candidates.
-            let mut new_slips: Vec<Vec<f64>> = fresh
-                .iter()
-                .map(|l| vec![0.0; l.len() * PAIR_STATE])
-                .collect();
+            let mut new_slips: Vec<Vec<f64>> =
+                fresh.iter().map(|l| vec![0.0; l.len() * ns]).collect();
             if slips.len() == cand.len() {
                 for e in 0..fresh.len().min(cand.len()) {
                     for (k, f) in fresh[e].iter().enumerate() {
                         if let Ok(old) = cand[e].binary_search(f) {
-                            new_slips[e][k * PAIR_STATE..(k + 1) * PAIR_STATE].copy_from_slice(
-                                &slips[e][old * PAIR_STATE..(old + 1) * PAIR_STATE],
-                            );
+                            new_slips[e][k * ns..(k + 1) * ns]
+                                .copy_from_slice(&slips[e][old * ns..(old + 1) * ns]);
                         }
                     }
                 }
@@ -572,9 +508,8 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         }
         let lists = &*cand;
         let slips: &mut Vec<Vec<f64>> = &mut slips;
-        let penalty = self.penalty;
-        let friction = self.friction;
-        let damping = self.damping;
+        let model = self.model.as_deref().expect("init ran");
+        let penalty = model.normal_penalty();
         let bonds = self.bonds.as_ref();
         let broken: &[f64] = match bonds.and_then(|b| b.id) {
             Some(id) => ctx.fields.get(id),
@@ -613,16 +548,9 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
                             (&other, &me, f, e)
                         };
                         let mut pair = triangle_pair_force(c, t, penalty);
-                        let state = &mut slip[k * PAIR_STATE..(k + 1) * PAIR_STATE];
-                        if friction.is_some() || damping.is_some() {
-                            let h = 0.5 * (mean_edge(ci) + mean_edge(ti));
-                            if let Some(d) = damping {
-                                apply_damping(&mut pair, d, h, state);
-                            }
-                            if let Some(fr) = friction {
-                                add_friction(&mut pair, kin, ci, ti, fr, h, &mut state[0]);
-                            }
-                        }
+                        let h = 0.5 * (mean_edge(ci) + mean_edge(ti));
+                        let state = &mut slip[k * ns..(k + 1) * ns];
+                        apply_model(&mut pair, kin, ci, ti, model, h, state);
                         let share = if e < f { pair.contactor } else { pair.target };
                         for a in 0..3 {
                             slot[2 * a] += share[a][0];
@@ -642,37 +570,6 @@ mod tests {
     use proptest::prelude::*;
 
     proptest! {
-        /// Contact damping (eq. 61) never raises the force above the undamped one, never
-        /// above T h, keeps its direction, and is the identity for b = 1 with T out of reach.
-        #[test]
-        fn damping_bounded_and_passive(stresses in proptest::collection::vec(0.0f64..1e7, 1..40),
-                                       t in 1e5f64..1e7, b in 1.0f64..5.0, h in 0.01f64..0.1) {
-            let mut state = [0.0; PAIR_STATE];
-            let mut ident = [0.0; PAIR_STATE];
-            for &s_try in &stresses {
-                // A pair whose normal force is s_try h along (0.6, 0.8), split over nodes.
-                let f = s_try * h;
-                let mk = || crate::PairForce2 {
-                    contactor: [[0.6 * f * 0.5, 0.8 * f * 0.5], [0.6 * f * 0.3, 0.8 * f * 0.3], [0.6 * f * 0.2, 0.8 * f * 0.2]],
-                    target: [[-0.6 * f * 0.4, -0.8 * f * 0.4], [-0.6 * f * 0.4, -0.8 * f * 0.4], [-0.6 * f * 0.2, -0.8 * f * 0.2]],
-                };
-                let mut p = mk();
-                apply_damping(&mut p, ContactDamping { transition: t, exponent: b }, h, &mut state);
-                let fx: f64 = p.contactor.iter().map(|v| v[0]).sum();
-                let fy: f64 = p.contactor.iter().map(|v| v[1]).sum();
-                let mag = (fx * fx + fy * fy).sqrt();
-                prop_assert!(mag <= f * (1.0 + 1e-12) + 1e-300);
-                prop_assert!(mag <= t * h * (1.0 + 1e-12));
-                prop_assert!(fx >= 0.0 && fy >= 0.0);
-                let tx: f64 = p.target.iter().map(|v| v[0]).sum();
-                prop_assert!((tx + fx).abs() <= 1e-9 * f.max(1e-300));
-                let mut q = mk();
-                apply_damping(&mut q, ContactDamping { transition: 1e300, exponent: 1.0 }, h, &mut ident);
-                let qx: f64 = q.contactor.iter().map(|v| v[0]).sum();
-                prop_assert!((qx - 0.6 * f).abs() <= 1e-12 * f + 1e-300);
-            }
-        }
-
         /// Friction never exceeds tan φ times the normal force, and once sliding it
         /// opposes the relative sliding velocity of the contactor.
         #[test]
@@ -690,13 +587,17 @@ mod tests {
             let kin = Kinematics { mesh: &mesh, mass: &mass, u: &u, v: &v, time: 0.0, dt: 1e-3, step: 0, damping: false };
             let c = Contact::element_xy(&kin, 1);
             let t = Contact::element_xy(&kin, 0);
-            let fr = Friction { angle_deg: phi, penalty: 1e9 };
-            let mut slip = 0.0;
+            let law = MohrCoulombContact {
+                normal_penalty: 1e9,
+                friction: Some(Friction { angle_deg: phi, penalty: 1e9 }),
+                damping: None,
+            };
+            let mut state = [0.0; 3];
             for _ in 0..50 {
                 let normal = triangle_pair_force(&c, &t, 1e9);
                 prop_assume!(normal.contactor.iter().any(|f| f[0] != 0.0 || f[1] != 0.0));
                 let mut pair = normal;
-                add_friction(&mut pair, &kin, 1, 0, fr, 1.0, &mut slip);
+                apply_model(&mut pair, &kin, 1, 0, &law, 1.0, &mut state);
                 let sum = |p: &[[f64; 2]; 3]| [p.iter().map(|f| f[0]).sum::<f64>(), p.iter().map(|f| f[1]).sum::<f64>()];
                 let (fn_, ft_all) = (sum(&normal.contactor), sum(&pair.contactor));
                 let ft = [ft_all[0] - fn_[0], ft_all[1] - fn_[1]];

@@ -131,3 +131,34 @@ fn contact_damping_parameters_are_checked() {
         assert!(err.contains("damping"), "{err}");
     }
 }
+
+/// A user contact law through the plugin trait: a "no-tension, capped" law that limits
+/// the normal stress to 1 MPa. The bodies still bounce apart, momentum is kept, and a
+/// pass-through law gives exactly the built-in frictionless result.
+#[test]
+fn user_contact_model_plugs_in() {
+    use pcdc_contact::{ContactModel, ContactStress};
+    #[derive(Debug)]
+    struct Capped(f64);
+    impl ContactModel for Capped {
+        fn name(&self) -> &str {
+            "capped (test)"
+        }
+        fn normal_penalty(&self) -> f64 {
+            10.0 * E
+        }
+        fn update(&self, s_try: f64, _dslip: f64, _h: f64, _state: &mut [f64]) -> ContactStress {
+            ContactStress {
+                normal: s_try.min(self.0),
+                shear: 0.0,
+            }
+        }
+    }
+    let (same, _, _, _) = run_with(1, Contact::new(1.0).with_model(Capped(f64::INFINITY)));
+    let (built_in, _, _, _) = run_with(1, Contact::new(10.0 * E));
+    assert_eq!(same.state.u, built_in.state.u);
+    let (capped, p0, p1, _) = run_with(1, Contact::new(1.0).with_model(Capped(1e6)));
+    let scale = capped.mass().iter().sum::<f64>();
+    assert!((p1 - p0).abs() <= 1e-10 * scale);
+    assert_ne!(capped.state.u, built_in.state.u);
+}
