@@ -17,5 +17,5 @@ mod physics;
 mod potential2d;
 
 pub use model::{ContactDamping, ContactModel, ContactStress, Friction, MohrCoulombContact};
-pub use physics::{Contact, CONTACT_REFERENCE};
+pub use physics::{element_boxes, grid_candidates, Contact, CONTACT_REFERENCE};
 pub use potential2d::{potential, triangle_pair_force, PairForce2};

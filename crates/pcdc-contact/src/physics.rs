@@ -227,79 +227,139 @@ impl Contact {
         t
     }
 
-    /// Rebuilds the candidate lists with a uniform grid of sorted cell keys.
+    /// Rebuilds the candidate lists: element boxes inflated by half the skin, then the
+    /// sorted grid ([`grid_candidates`]).
     fn build<D: Dim>(&self, kin: &Kinematics<'_, D>) -> Vec<Vec<u32>> {
-        let ne = kin.mesh.n_elements();
-        let half = 0.5 * self.skin_used;
-        let boxes: Vec<[f64; 4]> = (0..ne)
-            .map(|e| {
-                let t = Self::element_xy(kin, e);
-                let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-                for p in &t {
-                    for k in 0..2 {
-                        lo[k] = lo[k].min(p[k] - half);
-                        hi[k] = hi[k].max(p[k] + half);
-                    }
+        let boxes = element_boxes(kin, 0.5 * self.skin_used);
+        grid_candidates(&boxes, kin.mesh.elements())
+    }
+}
+
+/// Axis-aligned boxes `[x_min, y_min, x_max, y_max]` (m) of the current triangles,
+/// inflated by `margin` on every side.
+pub fn element_boxes<D: Dim>(kin: &Kinematics<'_, D>, margin: f64) -> Vec<[f64; 4]> {
+    (0..kin.mesh.n_elements())
+        .map(|e| {
+            let t = Contact::element_xy(kin, e);
+            let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+            for p in &t {
+                for k in 0..2 {
+                    lo[k] = lo[k].min(p[k] - margin);
+                    hi[k] = hi[k].max(p[k] + margin);
                 }
-                [lo[0], lo[1], hi[0], hi[1]]
-            })
-            .collect();
-        let cell = boxes
-            .iter()
-            .map(|b| (b[2] - b[0]).max(b[3] - b[1]))
-            .fold(0.0f64, f64::max)
-            .max(f64::MIN_POSITIVE);
-        let origin = boxes
-            .iter()
-            .fold([f64::INFINITY; 2], |o, b| [o[0].min(b[0]), o[1].min(b[1])]);
-        let key = |x: f64, y: f64| -> (i64, i64) {
-            (
-                ((x - origin[0]) / cell).floor() as i64,
-                ((y - origin[1]) / cell).floor() as i64,
-            )
-        };
-        let mut keyed: Vec<((i64, i64), u32)> = boxes
-            .iter()
-            .enumerate()
-            .map(|(e, b)| (key(0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])), e as u32))
-            .collect();
-        keyed.sort_unstable();
-        let find = |k: (i64, i64)| -> &[((i64, i64), u32)] {
-            let start = keyed.partition_point(|x| x.0 < k);
-            let end = keyed.partition_point(|x| x.0 <= k);
-            &keyed[start..end]
-        };
-        let conn = kin.mesh.elements();
-        (0..ne)
+            }
+            [lo[0], lo[1], hi[0], hi[1]]
+        })
+        .collect()
+}
+
+/// The broad phase: for every triangle, the sorted list of triangles whose boxes overlap
+/// its own and that share no node with it (`conn`: 3 nodes per triangle). Boxes are
+/// binned on a uniform grid of cell size = the largest box extent and each box looks in
+/// its own and the eight neighbouring cells. A compact domain uses a dense grid filled
+/// by counting sort (O(n)); scattered bodies use sorted cell keys (O(n log n)). No
+/// pointer structure, deterministic. (Measured against parry's BVH in
+/// `benches/broad_phase.rs`: the grid is the faster; see docs/performance.md.)
+pub fn grid_candidates(boxes: &[[f64; 4]], conn: &[u32]) -> Vec<Vec<u32>> {
+    let ne = boxes.len();
+    let cell = boxes
+        .iter()
+        .map(|b| (b[2] - b[0]).max(b[3] - b[1]))
+        .fold(0.0f64, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let origin = boxes
+        .iter()
+        .fold([f64::INFINITY; 2], |o, b| [o[0].min(b[0]), o[1].min(b[1])]);
+    let key = |x: f64, y: f64| -> (i64, i64) {
+        (
+            ((x - origin[0]) / cell).floor() as i64,
+            ((y - origin[1]) / cell).floor() as i64,
+        )
+    };
+    let keys: Vec<(i64, i64)> = boxes
+        .iter()
+        .map(|b| key(0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])))
+        .collect();
+    let (ncx, ncy) = keys
+        .iter()
+        .fold((0i64, 0i64), |(a, b), k| (a.max(k.0 + 1), b.max(k.1 + 1)));
+    // Test one candidate pair: boxes overlap and no shared node.
+    let accept = |e: usize, f: usize| -> bool {
+        let (b, o) = (boxes[e], boxes[f]);
+        f != e
+            && !(o[0] > b[2] || b[0] > o[2] || o[1] > b[3] || b[1] > o[3])
+            && !conn[3 * f..3 * f + 3]
+                .iter()
+                .any(|n| conn[3 * e..3 * e + 3].contains(n))
+    };
+    if (ncx as u128) * (ncy as u128) <= (4 * ne + 1024) as u128 {
+        // Compact domain: a dense grid, cells filled by counting sort (CSR), O(n).
+        let (ncx, ncy) = (ncx as usize, ncy as usize);
+        let cell_of = |k: (i64, i64)| k.0 as usize + k.1 as usize * ncx;
+        let mut start = vec![0u32; ncx * ncy + 1];
+        for k in &keys {
+            start[cell_of(*k) + 1] += 1;
+        }
+        for c in 0..ncx * ncy {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; ne];
+        for (e, k) in keys.iter().enumerate() {
+            let c = cell_of(*k);
+            items[fill[c] as usize] = e as u32;
+            fill[c] += 1;
+        }
+        return (0..ne)
             .into_par_iter()
             .map(|e| {
-                let b = boxes[e];
-                let (cx, cy) = key(0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3]));
-                let mine = &conn[3 * e..3 * e + 3];
+                let (cx, cy) = keys[e];
                 let mut list = Vec::new();
-                for dx in -1..=1 {
-                    for dy in -1..=1 {
-                        for &(_, f) in find((cx + dx, cy + dy)) {
-                            let f = f as usize;
-                            if f == e {
-                                continue;
+                for y in (cy - 1).max(0)..=(cy + 1).min(ncy as i64 - 1) {
+                    for x in (cx - 1).max(0)..=(cx + 1).min(ncx as i64 - 1) {
+                        let c = cell_of((x, y));
+                        for &f in &items[start[c] as usize..start[c + 1] as usize] {
+                            if accept(e, f as usize) {
+                                list.push(f);
                             }
-                            let o = boxes[f];
-                            if o[0] > b[2] || b[0] > o[2] || o[1] > b[3] || b[1] > o[3] {
-                                continue;
-                            }
-                            if conn[3 * f..3 * f + 3].iter().any(|n| mine.contains(n)) {
-                                continue;
-                            }
-                            list.push(f as u32);
                         }
                     }
                 }
                 list.sort_unstable();
                 list
             })
-            .collect()
+            .collect();
     }
+    // Scattered bodies (e.g. fragments far apart): sorted cell keys, binary search.
+    let mut keyed: Vec<((i64, i64), u32)> = keys
+        .iter()
+        .enumerate()
+        .map(|(e, k)| (*k, e as u32))
+        .collect();
+    keyed.sort_unstable();
+    let find = |k: (i64, i64)| -> &[((i64, i64), u32)] {
+        let start = keyed.partition_point(|x| x.0 < k);
+        let end = keyed.partition_point(|x| x.0 <= k);
+        &keyed[start..end]
+    };
+    (0..ne)
+        .into_par_iter()
+        .map(|e| {
+            let (cx, cy) = keys[e];
+            let mut list = Vec::new();
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for &(_, f) in find((cx + dx, cy + dy)) {
+                        if accept(e, f as usize) {
+                            list.push(f);
+                        }
+                    }
+                }
+            }
+            list.sort_unstable();
+            list
+        })
+        .collect()
 }
 
 impl<D: Dim, B: Backend> Physics<D, B> for Contact {
