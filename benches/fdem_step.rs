@@ -1,9 +1,10 @@
-//! The standard FDEM benchmark scene of DESIGN.md without contact (which arrives with
-//! pcdc-contact): a 0.05 x 0.10 m block of right triangles, every triangle with its own
+//! The standard FDEM benchmark scene of DESIGN.md: a 0.05 x 0.10 m block of right triangles, every triangle with its own
 //! nodes, an intrinsic cohesive joint on every interior edge (penalties 10 E, overlap
 //! 100 E, Ts = 2 MPa, c = 10 MPa), E = 30 GPa, nu = 0.25, rho = 2600, bottom fixed in y,
 //! top pushed at 0.05 m/s, dt = 0.05 h / c_p; 10k, 50k and 200k triangles, 1 thread and
-//! all threads.
+//! all threads. Rows `..._joints_...` leave contact out; rows `..._contact_...` are the
+//! full scene with contact on (penalty 10 E, friction 30° with shear penalty 10 E,
+//! bonded neighbours excluded until their joint breaks), 10k and 50k triangles.
 //!
 //! GPU rows (when an adapter exists, f64 and f32): one iteration is `run(GPU_STEPS)`,
 //! which includes one upload and one read-back of the state, so the rate is per
@@ -17,6 +18,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm};
 use pcdc_compute::{Backend, CpuBackend, Precision, Simulation, WgpuBackend};
+use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
 
@@ -26,23 +28,36 @@ const E: f64 = 30e9;
 const GPU_STEPS: u64 = 20;
 
 fn scene<B: Backend>(cells_x: usize, backend: B) -> Simulation<Dim2, B> {
+    scene_with(cells_x, backend, false)
+}
+
+fn scene_with<B: Backend>(cells_x: usize, backend: B, contact: bool) -> Simulation<Dim2, B> {
     let h = 0.05 / cells_x as f64;
     let mesh = builders::rectangle(0.0, 0.0, 0.05, 0.10, h).unwrap();
     let split = split_nodes(&mesh, &Range::All).unwrap();
+    let bond_elements = split.joints.elements.clone();
+    let bond_faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
     let czm = IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, 10.0 * E, 10.0 * E, 100.0 * E).unwrap();
     let rock = LinearElastic::new(E, 0.25, 2600.0).unwrap();
     let c_p = ((rock.lambda() + 2.0 * rock.shear()) / 2600.0).sqrt();
-    Simulation::builder(split.mesh, backend)
+    let mut b = Simulation::builder(split.mesh, backend)
         .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
-        .physics(
-            Boundary::new()
-                .velocity(Range::group("bottom"), [None, Some(0.0.into()), None])
-                .velocity(Range::group("top"), [None, Some((-0.05).into()), None]),
-        )
-        .time_step(0.05 * h / c_p)
-        .build()
-        .unwrap()
+        .physics(CohesiveJoints::new(split.joints).model(Range::All, czm));
+    if contact {
+        b = b.physics(
+            Contact::new(10.0 * E)
+                .friction(30.0, 10.0 * E)
+                .bonded_pairs(&bond_elements, &bond_faces, pcdc_cohesive::BROKEN_FACE),
+        );
+    }
+    b.physics(
+        Boundary::new()
+            .velocity(Range::group("bottom"), [None, Some(0.0.into()), None])
+            .velocity(Range::group("top"), [None, Some((-0.05).into()), None]),
+    )
+    .time_step(0.05 * h / c_p)
+    .build()
+    .unwrap()
 }
 
 fn bench(c: &mut Criterion) {
@@ -67,6 +82,17 @@ fn bench(c: &mut Criterion) {
             }
             g.throughput(Throughput::Elements(n as u64));
             g.bench_function(format!("tri3_{}k_joints_threads_{t}", n / 1000), |b| {
+                b.iter(|| sim.step().unwrap())
+            });
+        }
+    }
+    // The full scene with contact (CPU).
+    for nx in [50, 112] {
+        for &t in &threads {
+            let mut sim = scene_with(nx, CpuBackend::new(t).unwrap(), true);
+            let n = sim.mesh().n_elements();
+            g.throughput(Throughput::Elements(n as u64));
+            g.bench_function(format!("tri3_{}k_contact_threads_{t}", n / 1000), |b| {
                 b.iter(|| sim.step().unwrap())
             });
         }
