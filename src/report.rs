@@ -66,13 +66,19 @@ impl ResultLine {
 
 impl fmt::Display for ResultLine {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // Plain decimals for ordinary tolerances (0.03), exponent form for tiny ones (1e-12).
+        let tol = if self.tol != 0.0 && self.tol.abs() < 1e-3 {
+            format!("{:e}", self.tol)
+        } else {
+            format!("{}", self.tol)
+        };
         write!(
             f,
             "RESULT case={} metric={} value={:.6e} tol={} pass={} elements={} steps={} wall_s={:.3} backend={} precision={}",
             self.case,
             self.metric,
             self.value,
-            self.tol,
+            tol,
             self.pass(),
             self.elements,
             self.steps,

@@ -1,15 +1,16 @@
 //! # pcdc-compute
 //!
 //! The engine of pcdc-rs: backends ([`CpuBackend`], rayon, deterministic for any thread
-//! count), field storage that allocates only what the composed physics declare
+//! count; [`WgpuBackend`], wgpu on a GPU with device-resident fields, f64 or f32 from one
+//! WGSL template, see [`gpu`]; [`BackendChoice`] picks one at run time), field storage that allocates only what the composed physics declare
 //! ([`FieldStore`]), the [`Physics`] trait, the [`Simulation`] with explicit
 //! central-difference integration (manual 7.1 eq. i-v) with lumped mass and gravity, a
 //! stable time step with a safety factor and a report of the limiting entity, static
 //! mode by dynamic relaxation or a direct sparse solve (manual 7.2.7 "dynamic off"), time
 //! [`Table`]s, [`History`] probes to CSV, a divergence watchdog and save/restore.
 //!
-//! Assembly uses no atomics: each physics writes forces into its own slots, registered
-//! once per node; each node sums its slots in registration order.
+//! Assembly uses no float atomics on either backend: each physics writes forces into its
+//! own slots, registered once per node; each node sums its slots in registration order.
 
 #![warn(missing_docs)]
 // Index loops mirror the tensor notation of the manual's equations.

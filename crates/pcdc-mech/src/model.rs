@@ -39,7 +39,7 @@ pub trait ConstitutiveModel: Send + Sync + std::fmt::Debug {
     /// variables.
     fn update(&self, strain: &Sym6, dstrain: &Sym6, stress: &mut Sym6, state: &mut [f64]);
     /// The constant tangent `dσ/dε` as a 6x6 matrix acting on tensor strain components
-    /// (σ_xy = T[3][3] ε_xy, ...), if the model is linear; enables the direct static solve.
+    /// (`σ_xy = T[3][3] ε_xy`, ...), if the model is linear; enables the direct static solve.
     fn linear_tangent(&self) -> Option<[[f64; 6]; 6]> {
         None
     }
