@@ -18,7 +18,7 @@
 
 use std::sync::Arc;
 
-use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase};
+use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase};
 use pcdc_compute::{
     Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext, Kinematics,
     Location, Physics, StableStep,
@@ -426,42 +426,29 @@ impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
             data.push(*w);
         }
         // One WGSL function per distinct model key; parameters per model.
-        let mut keys: Vec<String> = Vec::new();
-        let mut functions = String::new();
-        let mut model_info = Vec::with_capacity(self.models.len());
+        let mut bodies = Vec::with_capacity(self.models.len());
         for m in &self.models {
-            let w = m.wgsl().ok_or_else(|| ComputeError::NoGpuKernel {
+            bodies.push(m.wgsl().ok_or_else(|| ComputeError::NoGpuKernel {
                 physics: "cohesive joints".into(),
                 reason: format!(
                     "joint model '{}' has no WGSL body (implement JointModel::wgsl)",
                     m.name()
                 ),
-            })?;
-            let kind = match keys.iter().position(|k| *k == w.key) {
-                Some(k) => k,
-                None => {
-                    keys.push(w.key.clone());
-                    functions.push_str(&format!(
-                        "// joint model '{}'\nfn joint_model_{}(o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32) -> JointTraction {{\n{}\n}}\n",
-                        w.key,
-                        keys.len() - 1,
-                        w.body
-                    ));
-                    keys.len() - 1
-                }
-            };
-            model_info.push([kind as u32, data.len() as u32]);
+            })?);
+        }
+        let splice = splice_models(
+            "joint_model",
+            "o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32",
+            "o, slip, h, state, p",
+            "JointTraction",
+            None,
+            bodies.iter().map(|w| (w.key.as_str(), w.body.as_str())),
+        );
+        let mut model_info = Vec::with_capacity(bodies.len());
+        for (w, kind) in bodies.iter().zip(&splice.kinds) {
+            model_info.push([*kind, data.len() as u32]);
             data.extend_from_slice(&w.params);
         }
-        let mut dispatch = String::from(
-            "fn call_joint_model(kind: u32, o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32) -> JointTraction {\n    var out: JointTraction;\n    switch kind {\n",
-        );
-        for k in 0..keys.len() {
-            dispatch.push_str(&format!(
-                "        case {k}u: {{ out = joint_model_{k}(o, slip, h, state, p); }}\n"
-            ));
-        }
-        dispatch.push_str("        default: {}\n    }\n    return out;\n}\n");
         let h_at = data.len();
         data.extend_from_slice(&self.h);
         // Per joint: side A nodes, side B nodes, faces A and B, model kind, parameter offset.
@@ -475,7 +462,8 @@ impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
         let info = setup.upload("joint info", GpuData::U32(info));
         let data = setup.upload("joint data", GpuData::Real(data));
         let source = format!(
-            "alias JointVec = array<Real, 3>;\nalias JointState = array<Real, NSTATE>;\nstruct JointTraction {{\n    normal: Real,\n    shear: JointVec,\n    damage: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return joint_data[p + k]; }}\n{JOINT_LIBRARY}{functions}{dispatch}{JOINT_KERNEL}"
+            "alias JointVec = array<Real, 3>;\nalias JointState = array<Real, NSTATE>;\nstruct JointTraction {{\n    normal: Real,\n    shear: JointVec,\n    damage: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return joint_data[p + k]; }}\n{JOINT_LIBRARY}{}{JOINT_KERNEL}",
+            splice.source
         );
         let mut kernel = Kernel::new(format!("cohesive joints {}", D::NAME), source, nj)
             .const_u32("D", D::D as u32)

@@ -10,7 +10,7 @@
 
 use std::sync::Arc;
 
-use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase};
+use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase};
 use pcdc_compute::{
     names, Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
     Kinematics, Location, Physics, StableStep,
@@ -609,43 +609,30 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
     fn gpu_setup(&mut self, setup: &mut GpuSetup<'_, D>) -> Result<(), ComputeError> {
         let (d, ne) = (D::D, self.material.len());
         // One WGSL function per distinct model code; parameters per material.
-        let mut keys: Vec<String> = Vec::new();
-        let mut functions = String::new();
-        let mut mat_info = Vec::with_capacity(2 * self.models.len());
-        let mut params = Vec::new();
+        let mut bodies = Vec::with_capacity(self.models.len());
         for m in &self.models {
-            let w = m.wgsl().ok_or_else(|| ComputeError::NoGpuKernel {
+            bodies.push(m.wgsl().ok_or_else(|| ComputeError::NoGpuKernel {
                 physics: "mechanics".into(),
                 reason: format!(
                     "constitutive model '{}' has no WGSL body (implement ConstitutiveModel::wgsl)",
                     m.name()
                 ),
-            })?;
-            let kind = match keys.iter().position(|k| *k == w.key) {
-                Some(k) => k,
-                None => {
-                    keys.push(w.key.clone());
-                    functions.push_str(&format!(
-                        "// model '{}'\nfn model_{}(strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, p: u32) -> Sym {{\n{}\n}}\n",
-                        w.key,
-                        keys.len() - 1,
-                        w.body
-                    ));
-                    keys.len() - 1
-                }
-            };
-            mat_info.extend([kind as u32, params.len() as u32]);
+            })?);
+        }
+        let splice = splice_models(
+            "model",
+            "strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, p: u32",
+            "strain, dstrain, stress, state, p",
+            "Sym",
+            Some("stress"),
+            bodies.iter().map(|w| (w.key.as_str(), w.body.as_str())),
+        );
+        let mut mat_info = Vec::with_capacity(2 * bodies.len());
+        let mut params = Vec::new();
+        for (w, kind) in bodies.iter().zip(&splice.kinds) {
+            mat_info.extend([*kind, params.len() as u32]);
             params.extend_from_slice(&w.params);
         }
-        let mut dispatch = String::from(
-            "fn call_model(kind: u32, strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, p: u32) -> Sym {\n    var out = stress;\n    switch kind {\n",
-        );
-        for k in 0..keys.len() {
-            dispatch.push_str(&format!(
-                "        case {k}u: {{ out = model_{k}(strain, dstrain, stress, state, p); }}\n"
-            ));
-        }
-        dispatch.push_str("        default: {}\n    }\n    return out;\n}\n");
         if params.is_empty() {
             params.push(0.0);
         }
@@ -672,7 +659,8 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
             include_str!("shaders/element_3d.wgsl")
         };
         let source = format!(
-            "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{functions}{dispatch}{template}"
+            "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{}{template}",
+            splice.source
         );
         let polar_tol = match setup.precision() {
             pcdc_compute::Precision::F64 => 1e-15,

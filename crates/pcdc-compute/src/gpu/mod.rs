@@ -25,7 +25,7 @@ mod run;
 
 pub use backend::{gpu_test_backend, BackendChoice, Precision, WgpuBackend};
 pub use program::{
-    assemble_source, offline_kernel_sources, validate_wgsl, Access, ConstValue, GpuBuffer, GpuData,
-    GpuSetup, Kernel, Phase, PRELUDE,
+    assemble_source, offline_kernel_sources, splice_models, validate_wgsl, Access, ConstValue,
+    GpuBuffer, GpuData, GpuSetup, Kernel, ModelSplice, Phase, PRELUDE,
 };
 pub(crate) use run::GpuRun;

@@ -360,6 +360,63 @@ pub fn assemble_source(
     })
 }
 
+/// Plugin WGSL spliced into a kernel template: see [`splice_models`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelSplice {
+    /// One function `{prefix}_{k}` per distinct model key, then the dispatcher
+    /// `fn call_{prefix}(kind: u32, <params>) -> <ret>`.
+    pub source: String,
+    /// Kind (index into the distinct keys) of every model, in input order.
+    pub kinds: Vec<u32>,
+}
+
+/// Splices plugin models (constitutive, joint, contact) into a kernel template: models
+/// given as `(key, body)` that share a key share one WGSL function
+/// `fn {prefix}_{k}({params}) -> {ret} {{ body }}`, and a dispatcher
+/// `fn call_{prefix}(kind: u32, {params}) -> {ret}` switches on the kind; an unknown
+/// kind returns `fallback` (a WGSL expression, or the zero value when `None`). `args` is
+/// `params` without the types (the names passed on).
+pub fn splice_models<'a>(
+    prefix: &str,
+    params: &str,
+    args: &str,
+    ret: &str,
+    fallback: Option<&str>,
+    models: impl IntoIterator<Item = (&'a str, &'a str)>,
+) -> ModelSplice {
+    let mut keys: Vec<&str> = Vec::new();
+    let mut source = String::new();
+    let mut kinds = Vec::new();
+    for (key, body) in models {
+        let kind = match keys.iter().position(|k| *k == key) {
+            Some(k) => k,
+            None => {
+                keys.push(key);
+                source.push_str(&format!(
+                    "// model '{key}'\nfn {prefix}_{}({params}) -> {ret} {{\n{body}\n}}\n",
+                    keys.len() - 1
+                ));
+                keys.len() - 1
+            }
+        };
+        kinds.push(kind as u32);
+    }
+    let init = match fallback {
+        Some(e) => format!("var out: {ret} = {e};"),
+        None => format!("var out: {ret};"),
+    };
+    source.push_str(&format!(
+        "fn call_{prefix}(kind: u32, {params}) -> {ret} {{\n    {init}\n    switch kind {{\n"
+    ));
+    for k in 0..keys.len() {
+        source.push_str(&format!(
+            "        case {k}u: {{ out = {prefix}_{k}({args}); }}\n"
+        ));
+    }
+    source.push_str("        default: {}\n    }\n    return out;\n}\n");
+    ModelSplice { source, kinds }
+}
+
 /// Parses and validates a WGSL module with naga (with f64 support), as wgpu would;
 /// returns the diagnostic with source context on failure.
 pub fn validate_wgsl(source: &str) -> Result<(), String> {
@@ -398,7 +455,7 @@ pub fn offline_kernel_sources<D: Dim, B: crate::Backend>(
             assemble(k, precision, &|b| program.elem_of(b)),
         ));
     }
-    for k in crate::gpu::run::builtin_kernels::<D>(mesh.n_nodes(), layout.n_slots) {
+    for k in crate::gpu::run::builtin_kernels::<D>(mesh.n_nodes()) {
         let k = k.const_real("RUNAWAY2", 1.0);
         out.push((
             k.label.clone(),

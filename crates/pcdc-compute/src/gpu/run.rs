@@ -15,7 +15,7 @@ const UPDATE_WATCHDOG: &str = include_str!("shaders/update_watchdog.wgsl");
 
 /// The built-in kernels: gather + velocity update, gather for force evaluation, position
 /// update + watchdog.
-pub(crate) fn builtin_kernels<D: Dim>(n_nodes: usize, _n_slots: usize) -> Vec<Kernel> {
+pub(crate) fn builtin_kernels<D: Dim>(n_nodes: usize) -> Vec<Kernel> {
     let d = D::D as u32;
     let b = |i: usize| GpuBuffer(i);
     let gather = |k: Kernel| {
@@ -372,7 +372,7 @@ impl GpuRun {
                 Phase::Kinematics => kinematics.push(p),
             }
         }
-        let mut builtins = builtin_kernels::<D>(sim.mesh.n_nodes(), layout.n_slots)
+        let mut builtins = builtin_kernels::<D>(sim.mesh.n_nodes())
             .into_iter()
             .map(|k| {
                 let k = if k.label == "update_watchdog" {
