@@ -18,7 +18,7 @@
 
 use std::sync::Arc;
 
-use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase};
+use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
 use pcdc_compute::{
     Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext, Kinematics,
     Location, Physics, StableStep,
@@ -462,7 +462,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
         let info = setup.upload("joint info", GpuData::U32(info));
         let data = setup.upload("joint data", GpuData::Real(data));
         let source = format!(
-            "alias JointVec = array<Real, 3>;\nalias JointState = array<Real, NSTATE>;\nstruct JointTraction {{\n    normal: Real,\n    shear: JointVec,\n    damage: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return joint_data[p + k]; }}\n{JOINT_LIBRARY}{}{JOINT_KERNEL}",
+            "alias JointVec = array<Real, 3>;\nalias JointState = array<Real, NSTATE>;\nstruct JointTraction {{\n    normal: Real,\n    shear: JointVec,\n    damage: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return joint_data[p + k]; }}\n{JOINT_LIBRARY}{WGSL_GEOMETRY}{}{JOINT_KERNEL}",
             splice.source
         );
         let mut kernel = Kernel::new(format!("cohesive joints {}", D::NAME), source, nj)

@@ -13,7 +13,7 @@
 //! added. Time tables are evaluated on the host once per step as signals, at exactly the
 //! times the CPU path uses, so f64 results match the CPU to rounding.
 
-use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase};
+use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
 use pcdc_compute::{
     Backend, ComputeError, DofConstraint, FieldId, FieldSpec, FieldStore, ForceContext,
     InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext,
@@ -457,7 +457,8 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
                         .flat_map(|&f| setup.mesh.face(f as usize).iter().copied())
                         .collect();
                     let faces = setup.upload(&label("face nodes"), GpuData::U32(face_nodes));
-                    let k = Kernel::new(label("face stress"), FACE_STRESS_WGSL, r.faces.len())
+                    let src = format!("{WGSL_GEOMETRY}{FACE_STRESS_WGSL}");
+                    let k = Kernel::new(label("face stress"), src, r.faces.len())
                         .const_u32("D", d)
                         .const_u32("NPF", npf as u32)
                         .const_real("NPF_REAL", npf as f64)

@@ -11,36 +11,6 @@
 // model kind, parameter offset. joint_data: Gauss points (N_0, N_1, N_2, weight) from
 // GAUSS_AT, model parameters, h per joint from H_AT.
 
-// Measure and unit normal of the midplane face (Dim::face_measure_normal).
-fn face_normal(mid: array<Real, 9>, n: ptr<function, JointVec>) -> Real {
-    if D == 2u {
-        let dx = mid[2] - mid[0];
-        let dy = mid[3] - mid[1];
-        let len = sqrt(dx * dx + dy * dy);
-        if len > 0.0 {
-            (*n)[0] = dy / len;
-            (*n)[1] = -dx / len;
-        }
-        return len;
-    }
-    let a0 = mid[3] - mid[0];
-    let a1 = mid[4] - mid[1];
-    let a2 = mid[5] - mid[2];
-    let b0 = mid[6] - mid[0];
-    let b1 = mid[7] - mid[1];
-    let b2 = mid[8] - mid[2];
-    let c0 = a1 * b2 - a2 * b1;
-    let c1 = a2 * b0 - a0 * b2;
-    let c2 = a0 * b1 - a1 * b0;
-    let len = sqrt(c0 * c0 + c1 * c1 + c2 * c2);
-    if len > 0.0 {
-        (*n)[0] = c0 / len;
-        (*n)[1] = c1 / len;
-        (*n)[2] = c2 / len;
-    }
-    return 0.5 * len;
-}
-
 fn kernel(j: u32) {
     let r = j * INFO;
     var mid: array<Real, 9>;
@@ -55,8 +25,9 @@ fn kernel(j: u32) {
             gap[k * D + c] = xb - xa;
         }
     }
-    var n: JointVec;
-    let area = face_normal(mid, &n);
+    var n: array<Real, 3>;
+    // Measure and unit normal of the midplane face.
+    let area = face_measure_normal(mid, &n);
     let kind = joint_info[r + 2u * NPF + 2u];
     let p = joint_info[r + 2u * NPF + 3u];
     let h = joint_data[H_AT + j];

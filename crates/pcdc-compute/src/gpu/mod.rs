@@ -29,3 +29,7 @@ pub use program::{
     GpuBuffer, GpuData, GpuSetup, Kernel, ModelSplice, Phase, PRELUDE,
 };
 pub(crate) use run::GpuRun;
+
+/// WGSL library of shared geometry for physics kernels (prepend it to a kernel's source):
+/// `fn face_measure_normal(x, &n) -> Real`, the twin of `Dim::face_measure_normal`.
+pub const WGSL_GEOMETRY: &str = include_str!("shaders/geometry.wgsl");

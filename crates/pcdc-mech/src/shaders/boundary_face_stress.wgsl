@@ -22,43 +22,7 @@ fn kernel(f: u32) {
         }
     }
     var n: array<Real, 3>;
-    var measure = Real(0.0);
-    if D == 2u {
-        // Edge a -> b of a counter-clockwise triangle: the outward normal is the edge
-        // direction turned clockwise.
-        let dx = x[2] - x[0];
-        let dy = x[3] - x[1];
-        let len = sqrt(dx * dx + dy * dy);
-        if len > 0.0 {
-            n[0] = dy / len;
-            n[1] = -dx / len;
-        } else {
-            n[0] = Real(0.0);
-            n[1] = Real(0.0);
-        }
-        measure = len;
-    } else {
-        let a0 = x[3] - x[0];
-        let a1 = x[4] - x[1];
-        let a2 = x[5] - x[2];
-        let b0 = x[6] - x[0];
-        let b1 = x[7] - x[1];
-        let b2 = x[8] - x[2];
-        let c0 = a1 * b2 - a2 * b1;
-        let c1 = a2 * b0 - a0 * b2;
-        let c2 = a0 * b1 - a1 * b0;
-        let len = sqrt(c0 * c0 + c1 * c1 + c2 * c2);
-        if len > 0.0 {
-            n[0] = c0 / len;
-            n[1] = c1 / len;
-            n[2] = c2 / len;
-        } else {
-            n[0] = Real(0.0);
-            n[1] = Real(0.0);
-            n[2] = Real(0.0);
-        }
-        measure = Real(0.5) * len;
-    }
+    let measure = face_measure_normal(x, &n);
     for (var s = 0u; s < NPF; s = s + 1u) {
         let base = (SLOT0 + f * NPF + s) * D;
         for (var c = 0u; c < D; c = c + 1u) {
