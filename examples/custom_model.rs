@@ -141,15 +141,16 @@ impl ConstitutiveModel for DamageElastic {
 }
 
 /// Outcome of one run: displacement, largest κ, steps, elements, wall time.
-struct Run {
-    u: Vec<f64>,
-    max_damage: f64,
-    steps: u64,
-    elements: usize,
-    wall_s: f64,
+pub(crate) struct Run {
+    pub(crate) u: Vec<f64>,
+    pub(crate) max_damage: f64,
+    pub(crate) steps: u64,
+    pub(crate) elements: usize,
+    pub(crate) wall_s: f64,
 }
 
-fn run<B: Backend>(backend: B) -> Result<Run, Box<dyn std::error::Error>> {
+/// Runs the scene on `backend` (also called by `tests/custom_model.rs`).
+pub(crate) fn run<B: Backend>(backend: B) -> Result<Run, Box<dyn std::error::Error>> {
     let model = DamageElastic {
         young: 20e9,
         poisson: 0.2,
@@ -222,7 +223,7 @@ fn main() {
                 .iter()
                 .zip(&gpu.u)
                 .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-            let tol = if gpu_backend.precision() == "f64" {
+            let tol = if gpu_backend.precision_kind() == pcdc::compute::Precision::F64 {
                 1e-12
             } else {
                 1e-2
