@@ -179,7 +179,7 @@ pub fn run<B: Backend>(backend: &B, p: &Params, solver: Solver) -> Result<Outcom
             // f32 forces carry ~1e-7 relative noise, which the unbalanced-force ratio
             // (net over gross) sees amplified; 1e-5 is safely reachable in f32, and the
             // f32 stress error is then reported as measured.
-            tolerance: if backend.precision() == "f32" {
+            tolerance: if backend.precision_kind() == pcdc_compute::Precision::F32 {
                 1e-5
             } else {
                 1e-6

@@ -33,9 +33,13 @@ pub trait Backend: Send + Sync + Clone + 'static {
     fn kind(&self) -> BackendKind;
     /// Number of worker threads (CPU) or 1 (GPU queue).
     fn threads(&self) -> usize;
-    /// Floating-point precision name (`f64` or `f32`).
+    /// Floating-point precision of the kernels (the CPU always runs f64).
+    fn precision_kind(&self) -> crate::Precision {
+        crate::Precision::F64
+    }
+    /// Floating-point precision name (`f64` or `f32`), as printed in RESULT lines.
     fn precision(&self) -> &'static str {
-        "f64"
+        self.precision_kind().name()
     }
     /// Runs host-side work `f` (rayon parallel iterators inside use this backend's CPU
     /// pool: the CPU backend's own, or the GPU backend's host pool).

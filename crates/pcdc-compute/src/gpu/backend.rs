@@ -184,11 +184,6 @@ impl WgpuBackend {
         self.inner.info.device_type == wgpu::DeviceType::Cpu
     }
 
-    /// Precision of the kernels.
-    pub fn precision_kind(&self) -> Precision {
-        self.inner.precision
-    }
-
     /// Number of device-to-host reads so far (each `run`, `evaluate_forces` or
     /// `update_state` call that ends in a read counts one).
     pub fn readbacks(&self) -> u64 {
@@ -220,8 +215,8 @@ impl Backend for WgpuBackend {
     fn threads(&self) -> usize {
         1
     }
-    fn precision(&self) -> &'static str {
-        self.inner.precision.name()
+    fn precision_kind(&self) -> Precision {
+        self.inner.precision
     }
     fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
         self.inner.host.install(f)
