@@ -196,6 +196,7 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             gather_ptr: layout.gather_ptr.clone(),
             gather_idx: layout.gather_idx.clone(),
             gpu: None,
+            device_fresh: false,
             mesh,
             backend,
             physics,
@@ -303,6 +304,9 @@ pub struct Simulation<D: Dim, B: Backend = CpuBackend> {
     pub(crate) local_damping: f64,
     /// Device state on the GPU backend.
     pub(crate) gpu: Option<Box<GpuRun>>,
+    /// True only between an internal read-back and the next internal device call that
+    /// may skip its upload (relaxation loop); public entry points always upload.
+    pub(crate) device_fresh: bool,
 }
 
 /// Snapshot file header, checked on restore.

@@ -114,6 +114,7 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
         self.state.v.fill(0.0);
         let free = self.free_dofs();
         let result = self.relax_loop(opts, &free);
+        self.device_fresh = false;
         self.mass = self.mass_phys.clone();
         self.local_damping = saved_alpha;
         self.dt = saved_dt;
@@ -135,8 +136,12 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
             let k = opts.check_every.min(opts.max_steps - it);
             self.run(k)?;
             it += k;
+            // The device holds the state just read back: the force evaluation and the
+            // next run need not upload it again (no user code runs in between).
+            self.device_fresh = true;
             if it % opts.check_every == 0 {
                 ratio = self.unbalanced_ratio(free)?;
+                self.device_fresh = true;
                 if ratio <= opts.tolerance {
                     return Ok(StaticReport { steps: it, ratio });
                 }

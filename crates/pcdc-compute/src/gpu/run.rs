@@ -450,11 +450,23 @@ impl GpuRun {
             let id = sim.state.fields.id(&spec.name).expect("declared field");
             self.write_reals(b, sim.state.fields.get(id));
         }
+    }
+
+    /// Clears the watchdog status (start of every run).
+    fn reset_status(&self) {
         self.backend.queue().write_buffer(
             &self.buffers[builtin::STATUS],
             0,
             bytemuck::cast_slice(&[u32::MAX; 4]),
         );
+    }
+
+    /// Uploads the host state unless the simulation knows the device already holds it
+    /// (`device_fresh`, set only by internal loops right after a read-back).
+    fn sync_to_device<D: Dim, B: Backend>(&self, sim: &mut Simulation<D, B>) {
+        if !std::mem::take(&mut sim.device_fresh) {
+            self.upload(sim);
+        }
     }
 
     fn record<D: Dim, B: Backend>(
@@ -506,7 +518,8 @@ impl GpuRun {
         if n == 0 {
             return Ok(());
         }
-        self.upload(sim);
+        self.sync_to_device(sim);
+        self.reset_status();
         let (t0, step0) = (sim.state.time, sim.state.step);
         let (mut t, mut step) = (t0, step0);
         let mut left = n;
@@ -581,7 +594,7 @@ impl GpuRun {
         sim: &mut Simulation<D, B>,
         gross: bool,
     ) -> Result<Option<Vec<f64>>, ComputeError> {
-        self.upload(sim);
+        self.sync_to_device(sim);
         let mut records = Vec::new();
         self.record(sim, sim.state.time, sim.state.step, &mut records);
         self.backend
