@@ -125,6 +125,10 @@ pub(crate) struct BufferDecl {
 /// step parameters; arguments: time at the start of the step (s) and the step (s).
 pub(crate) type Signal = Box<dyn Fn(f64, f64) -> f64 + Send + Sync>;
 
+/// A physics error a kernel can raise (see [`GpuSetup::error`]): the physics' name and
+/// the message for the reported entity.
+pub(crate) type ErrorMessage = (String, Box<dyn Fn(u32) -> String + Send + Sync>);
+
 /// Built-in buffers, in this order, before the fields and the uploaded data.
 pub(crate) mod builtin {
     pub const COORDS: usize = 0;
@@ -148,6 +152,8 @@ pub(crate) struct Program {
     pub field_buffers: Vec<usize>,
     pub kernels: Vec<(Phase, Kernel)>,
     pub signals: Vec<Signal>,
+    /// Physics errors by code (index).
+    pub errors: Vec<ErrorMessage>,
 }
 
 /// Handed to [`crate::Physics::gpu_setup`]: declare data, kernels and signals.
@@ -224,6 +230,37 @@ impl<D: Dim> GpuSetup<'_, D> {
     /// Number of slots of this physics.
     pub fn slot_count(&self) -> usize {
         self.slot_len
+    }
+
+    /// A zero-initialised scratch buffer of `len` integer atomics (`array<atomic<u32>>`),
+    /// for counting and flags (integer atomics only: never accumulate forces with them).
+    pub fn atomics(&mut self, label: &str, len: usize) -> GpuBuffer {
+        self.program.buffers.push(BufferDecl {
+            label: format!("{}: {label}", self.physics),
+            elem: Elem::Atomic,
+            len,
+            data: None,
+        });
+        GpuBuffer(self.program.buffers.len() - 1)
+    }
+
+    /// The run's status words (`array<atomic<u32>>`, 4 entries; bind it as `status`,
+    /// read-write). Entries 0-1 belong to the divergence watchdog; a kernel raises a
+    /// physics error from [`GpuSetup::error`] with
+    /// `atomicMin(&status[2], CODE); atomicMin(&status[3], entity);`.
+    pub fn status(&self) -> GpuBuffer {
+        GpuBuffer(builtin::STATUS)
+    }
+
+    /// Registers an error a kernel of this physics can raise and returns its code: after
+    /// the run (one read-back, as usual) the simulation returns
+    /// `ComputeError::Physics { physics, message: message(entity) }` for the smallest
+    /// raised code, with the smallest raised entity.
+    pub fn error(&mut self, message: impl Fn(u32) -> String + Send + Sync + 'static) -> u32 {
+        self.program
+            .errors
+            .push((self.physics.clone(), Box::new(message)));
+        (self.program.errors.len() - 1) as u32
     }
 
     /// A per-step scalar: `f(t, dt)` is evaluated on the host for every step (t = time at

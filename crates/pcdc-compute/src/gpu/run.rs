@@ -106,6 +106,7 @@ pub(crate) fn build_program<D: Dim, B: Backend>(
         field_buffers,
         kernels: Vec::new(),
         signals: Vec::new(),
+        errors: Vec::new(),
     };
     for (p, r) in physics.iter_mut().zip(&layout.slot_ranges) {
         let name = p.name().to_string();
@@ -140,6 +141,7 @@ pub(crate) struct GpuRun {
     buffers: Vec<wgpu::Buffer>,
     field_buffers: Vec<usize>,
     signals: Vec<super::program::Signal>,
+    errors: Vec<super::program::ErrorMessage>,
     forces: Vec<Pipeline>,
     kinematics: Vec<Pipeline>,
     gather_integrate: Pipeline,
@@ -200,6 +202,7 @@ impl GpuRun {
             field_buffers,
             kernels,
             signals,
+            errors,
         } = program;
         let eb = |e: Elem| match e {
             Elem::Real => precision.bytes(),
@@ -412,6 +415,7 @@ impl GpuRun {
             buffers,
             field_buffers,
             signals,
+            errors,
             forces,
             kinematics,
             gather_integrate,
@@ -572,6 +576,7 @@ impl GpuRun {
         let (status, _) = self.read_back(sim, false)?;
         sim.state.time = t;
         sim.state.step = step;
+        self.physics_error(&status)?;
         if status[0] != u32::MAX {
             // Step numbers are kept modulo 2^32 on the device.
             let lo = (step0 + 1) as u32;
@@ -595,6 +600,7 @@ impl GpuRun {
         gross: bool,
     ) -> Result<Option<Vec<f64>>, ComputeError> {
         self.sync_to_device(sim);
+        self.reset_status();
         let mut records = Vec::new();
         self.record(sim, sim.state.time, sim.state.step, &mut records);
         self.backend
@@ -618,7 +624,19 @@ impl GpuRun {
             self.dispatch(&mut pass, &self.gather_forces);
         }
         self.backend.queue().submit([enc.finish()]);
-        self.read_back(sim, gross).map(|(_, g)| g)
+        let (status, g) = self.read_back(sim, gross)?;
+        self.physics_error(&status)?;
+        Ok(g)
+    }
+
+    /// The physics error a kernel raised (status words 2-3), if any.
+    fn physics_error(&self, status: &[u32; 4]) -> Result<(), ComputeError> {
+        match self.errors.get(status[2] as usize) {
+            Some((physics, message)) if status[2] != u32::MAX => {
+                Err(ComputeError::physics(physics.clone(), message(status[3])))
+            }
+            _ => Ok(()),
+        }
     }
 
     /// Copies u, v, force, status (and gross) and the fields into the staging buffer and
