@@ -55,5 +55,5 @@ pub mod output;
 pub use actions::{reset_displacement, reset_element_state, reset_velocity, set_velocity};
 pub use boundary::{Boundary, Components, Constraint, FaceStress, ACCEL_VELOCITY};
 pub use error::MechError;
-pub use mechanics::Mechanics;
+pub use mechanics::{Mechanics, SurfaceProperties};
 pub use model::{double_dot, ConstitutiveModel, LinearElastic, Sym6, WgslModel};

@@ -52,6 +52,16 @@ struct ElementGeometry {
     dim: usize,
 }
 
+/// Per-element contact properties of the surfaces (manual table 1): friction angle
+/// (degrees, default 0) and contact penalty (Pa, default 10 E).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceProperties {
+    /// Friction angle per element (degrees).
+    pub friction_deg: Vec<f64>,
+    /// Contact penalty per element (Pa).
+    pub penalty: Vec<f64>,
+}
+
 /// Element mechanics: materials assigned by range; later assignments override earlier.
 #[derive(Debug, Default)]
 pub struct Mechanics {
@@ -95,6 +105,78 @@ impl Mechanics {
     pub fn initial_stress(mut self, range: Range, stress: Sym6) -> Self {
         self.initial_stress.push((range, stress));
         self
+    }
+
+    /// Resolves the material assignments: the model index of every element, and the
+    /// models in assignment order.
+    fn resolve<D: Dim>(
+        &self,
+        mesh: &Mesh<D>,
+    ) -> Result<(Vec<u16>, Vec<Arc<dyn ConstitutiveModel>>), MechError> {
+        let ne = mesh.n_elements();
+        if self.assignments.is_empty() {
+            return Err(MechError::param(
+                "material",
+                "none",
+                "assign at least one constitutive model with Mechanics::material",
+            )
+            );
+        }
+        if self.assignments.len() > u16::MAX as usize {
+            return Err(MechError::param(
+                "material count",
+                self.assignments.len(),
+                "at most 65535 assignments",
+            )
+            );
+        }
+        let mut material = vec![u16::MAX; ne];
+        let mut models = Vec::new();
+        for (i, (range, model)) in self.assignments.iter().enumerate() {
+            let sel = mesh.select_elements(range)?;
+            if sel.is_empty() {
+                return Err(MechError::EmptyRange {
+                    what: format!("material {} ({})", i, model.name()),
+                    range: format!("{range:?}"),
+                    entity: "element",
+                }
+                );
+            }
+            for e in sel {
+                material[e as usize] = i as u16;
+            }
+            models.push(model.clone());
+        }
+        if let Some(e) = material.iter().position(|&m| m == u16::MAX) {
+            return Err(MechError::param(
+                format!("material of element {e}"),
+                "none",
+                "every element needs a constitutive model; add a Mechanics::material covering it",
+            )
+            );
+        }
+        Ok((material, models))
+    }
+
+    /// The contact properties of the elements' surfaces (manual table 1, keywords
+    /// `friction` and `penalty`): what contact (`pcdc_contact::Contact::surface_defaults`) uses when no contact
+    /// law is set. Resolves the material assignments on `mesh` (as the simulation build
+    /// will), so it can be called before building.
+    pub fn surface_properties<D: Dim>(
+        &self,
+        mesh: &Mesh<D>,
+    ) -> Result<SurfaceProperties, MechError> {
+        let (material, models) = self.resolve(mesh)?;
+        Ok(SurfaceProperties {
+            friction_deg: material
+                .iter()
+                .map(|&m| models[m as usize].contact_friction())
+                .collect(),
+            penalty: material
+                .iter()
+                .map(|&m| models[m as usize].contact_penalty())
+                .collect(),
+        })
     }
 
     fn ids(&self) -> Ids {
@@ -432,47 +514,8 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
         let mesh = ctx.mesh;
         let ne = mesh.n_elements();
-        if self.assignments.is_empty() {
-            return Err(MechError::param(
-                "material",
-                "none",
-                "assign at least one constitutive model with Mechanics::material",
-            )
-            .into());
-        }
-        if self.assignments.len() > u16::MAX as usize {
-            return Err(MechError::param(
-                "material count",
-                self.assignments.len(),
-                "at most 65535 assignments",
-            )
-            .into());
-        }
-        let mut material = vec![u16::MAX; ne];
-        self.models.clear();
-        for (i, (range, model)) in self.assignments.iter().enumerate() {
-            let sel = mesh.select_elements(range).map_err(MechError::from)?;
-            if sel.is_empty() {
-                return Err(MechError::EmptyRange {
-                    what: format!("material {} ({})", i, model.name()),
-                    range: format!("{range:?}"),
-                    entity: "element",
-                }
-                .into());
-            }
-            for e in sel {
-                material[e as usize] = i as u16;
-            }
-            self.models.push(model.clone());
-        }
-        if let Some(e) = material.iter().position(|&m| m == u16::MAX) {
-            return Err(MechError::param(
-                format!("material of element {e}"),
-                "none",
-                "every element needs a constitutive model; add a Mechanics::material covering it",
-            )
-            .into());
-        }
+        let (material, models) = self.resolve(mesh)?;
+        self.models = models;
         self.material = material;
         self.n_state = self.models.iter().map(|m| m.n_state()).max().unwrap_or(0);
         self.geo = geometry(mesh);

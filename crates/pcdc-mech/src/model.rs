@@ -49,6 +49,16 @@ pub trait ConstitutiveModel: Send + Sync + std::fmt::Debug {
     fn wgsl(&self) -> Option<WgslModel> {
         None
     }
+    /// Friction angle of the element's surfaces for contact without a contact law
+    /// (degrees; manual table 1, keyword `friction`; default 0).
+    fn contact_friction(&self) -> f64 {
+        0.0
+    }
+    /// Contact penalty of the element's surfaces for contact without a contact law (Pa;
+    /// manual table 1, keyword `penalty`; default 10 E).
+    fn contact_penalty(&self) -> f64 {
+        10.0 * self.young()
+    }
 }
 
 /// A constitutive model's GPU code, spliced into the element kernel template.
@@ -84,6 +94,14 @@ pub struct LinearElastic {
     pub density: f64,
     /// Damping factor D_f (eq. 19), default 0 (undamped).
     pub damp_factor: f64,
+    /// Friction angle of the surfaces for contact without a contact law (degrees, table 1
+    /// keyword `friction`), default 0.
+    #[serde(default)]
+    pub friction: f64,
+    /// Contact penalty of the surfaces (Pa, table 1 keyword `penalty`); `None` means the
+    /// manual's default 10 E.
+    #[serde(default)]
+    pub contact_penalty: Option<f64>,
 }
 
 impl LinearElastic {
@@ -94,6 +112,8 @@ impl LinearElastic {
             poisson,
             density,
             damp_factor: 0.0,
+            friction: 0.0,
+            contact_penalty: None,
         };
         m.check()?;
         Ok(m)
@@ -128,7 +148,36 @@ impl LinearElastic {
         Ok(self)
     }
 
+    /// Sets the surface friction angle (degrees) and, optionally, the contact penalty
+    /// (Pa; default 10 E) that contact uses when no contact law is set (table 1).
+    pub fn with_contact(
+        mut self,
+        friction_deg: f64,
+        penalty: Option<f64>,
+    ) -> Result<Self, MechError> {
+        self.friction = friction_deg;
+        self.contact_penalty = penalty;
+        self.check()?;
+        Ok(self)
+    }
+
     fn check(&self) -> Result<(), MechError> {
+        if !(0.0..90.0).contains(&self.friction) {
+            return Err(MechError::param(
+                "friction angle",
+                self.friction,
+                "must lie in [0, 90) degrees",
+            ));
+        }
+        if let Some(p) = self.contact_penalty {
+            if !(p > 0.0 && p.is_finite()) {
+                return Err(MechError::param(
+                    "contact penalty",
+                    p,
+                    "must be positive and finite (Pa)",
+                ));
+            }
+        }
         if !(self.young > 0.0 && self.young.is_finite()) {
             return Err(MechError::param(
                 "Young's modulus E",
@@ -195,6 +244,12 @@ impl ConstitutiveModel for LinearElastic {
     }
     fn young(&self) -> f64 {
         self.young
+    }
+    fn contact_friction(&self) -> f64 {
+        self.friction
+    }
+    fn contact_penalty(&self) -> f64 {
+        self.contact_penalty.unwrap_or(10.0 * self.young)
     }
     fn wave_modulus(&self) -> f64 {
         self.lambda() + 2.0 * self.shear()
