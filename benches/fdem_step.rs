@@ -6,7 +6,8 @@
 //! full scene with contact on (penalty 10 E, friction 30° with shear penalty 10 E,
 //! bonded neighbours excluded until their joint breaks), 10k and 50k triangles.
 //!
-//! GPU rows (when an adapter exists, f64 and f32): one iteration is `run(GPU_STEPS)`,
+//! GPU rows (when an adapter exists, f64 and f32; joints only and with contact): one
+//! iteration is `run(GPU_STEPS)`,
 //! which includes one upload and one read-back of the state, so the rate is per
 //! triangle-step with the transfers amortised over GPU_STEPS steps. On a software adapter
 //! (Mesa's lavapipe) only the 10k mesh runs, and its rows prove that the path works, not
@@ -136,6 +137,12 @@ fn bench(c: &mut Criterion) {
             g.throughput(Throughput::Elements(n as u64 * GPU_STEPS));
             g.bench_function(
                 format!("tri3_{}k_joints_{name}_{}", n / 1000, p.name()),
+                |b| b.iter(|| sim.run(GPU_STEPS).unwrap()),
+            );
+            // The full scene with contact on the device.
+            let mut sim = scene_with(nx, gpu.clone(), true);
+            g.bench_function(
+                format!("tri3_{}k_contact_{name}_{}", n / 1000, p.name()),
                 |b| b.iter(|| sim.run(GPU_STEPS).unwrap()),
             );
         }

@@ -9,8 +9,6 @@
 //! `--precision f64|f32` (default f64 where the adapter supports it, or
 //! `PCDC_PRECISION`); the RESULT line carries `backend=` and `precision=`, e.g.
 //! `cargo run --release --example block_sliding -- --backend gpu --precision f32`.
-//! Contact has no GPU kernel yet, so on the GPU this example stops at the build with a
-//! `cannot run on the GPU backend` error (exit status 1).
 
 use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
 use pcdc::plot::Plot;

@@ -7,15 +7,33 @@
 //! friction with a shear penalty, eq. 59-60, and damping after An and Tannant, eq. 61),
 //! and the [`Contact`] physics (sorted-grid broad phase with a skin, deterministic
 //! element-centric assembly, bonded-neighbour exclusion for FDEM regions).
+//!
+//! Contact without a contact law uses the elements' own surface friction and penalty
+//! (manual table 1): [`Contact::surface_defaults`] with [`SurfaceContact`].
+//!
+//! On the GPU backend (2D) the broad phase is a uniform grid built by counting sort and
+//! the pair forces run element-centric in WGSL, repeating the CPU arithmetic (f64 results
+//! match the CPU to rounding); laws supply their WGSL through [`ContactModel::wgsl`]
+//! ([`WgslContactModel`]). See the `gpu` module notes in the source for the kernel
+//! sequence and the candidate capacity ([`Contact::gpu_capacity`]).
 
 #![warn(missing_docs)]
 // Index loops mirror the formulas.
 #![allow(clippy::needless_range_loop)]
 
+mod gpu;
 mod model;
 mod physics;
 mod potential2d;
+mod potential3d;
 
-pub use model::{ContactDamping, ContactModel, ContactStress, Friction, MohrCoulombContact};
-pub use physics::{element_boxes, grid_candidates, Contact, CONTACT_REFERENCE};
+pub use model::{
+    ContactDamping, ContactModel, ContactStress, Friction, MohrCoulombContact, SurfaceContact,
+    WgslContactModel,
+};
+pub use physics::{
+    element_boxes, element_boxes_3d, grid_candidates, grid_candidates_3d, Contact,
+    CONTACT_REFERENCE,
+};
 pub use potential2d::{potential, triangle_pair_force, PairForce2};
+pub use potential3d::{tet_pair_force, tet_potential, PairForce3};

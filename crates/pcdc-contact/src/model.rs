@@ -35,13 +35,88 @@ pub trait ContactModel: Send + Sync + Debug {
     fn check(&self) -> Result<(), ComputeError> {
         Ok(())
     }
+    /// Checks the law against the mesh (e.g. per-element data of the right length).
+    fn check_mesh(&self, n_elements: usize) -> Result<(), ComputeError> {
+        let _ = n_elements;
+        Ok(())
+    }
     /// Contact stresses of a touching pair from the trial normal stress `s_try` (Pa,
     /// positive), the tangential slip increment `dslip` over the step (m) and the
     /// contact length `h` (m); `state` holds [`ContactModel::n_state`] values.
     fn update(&self, s_try: f64, dslip: f64, h: f64, state: &mut [f64]) -> ContactStress;
-    /// The pair has separated: reset its history (default: zero).
+    /// Normal penalty for the pair of elements `c` (contactor) and `t` (target) (Pa);
+    /// default [`ContactModel::normal_penalty`]. Laws whose parameters vary by element
+    /// (such as [`SurfaceContact`]) override it, with `normal_penalty` the largest value
+    /// (it bounds the stable time step).
+    fn pair_penalty(&self, c: usize, t: usize) -> f64 {
+        let _ = (c, t);
+        self.normal_penalty()
+    }
+    /// [`ContactModel::update`] for the pair of elements `c` and `t`; default `update`.
+    fn update_pair(
+        &self,
+        c: usize,
+        t: usize,
+        s_try: f64,
+        dslip: f64,
+        h: f64,
+        state: &mut [f64],
+    ) -> ContactStress {
+        let _ = (c, t);
+        self.update(s_try, dslip, h, state)
+    }
+    /// The pair has separated: reset its history (default: zero; the GPU kernel always
+    /// zeroes it).
     fn separate(&self, state: &mut [f64]) {
         state.fill(0.0);
+    }
+    /// The law's GPU code (see [`WgslContactModel`]). `None` (the default) means CPU
+    /// only: building a GPU simulation with such a law is an error that names it
+    /// ([`pcdc_compute::ComputeError::NoGpuKernel`]).
+    fn wgsl(&self) -> Option<WgslContactModel> {
+        None
+    }
+}
+
+/// A contact law's GPU code, spliced into the contact kernel template (the counterpart
+/// of [`ContactModel::update`]).
+///
+/// `body` is the body of
+///
+/// ```text
+/// fn (s_try: Real, dslip: Real, h: Real, state: ptr<function, ContactState>, p: u32) -> ContactStress
+/// ```
+///
+/// with `struct ContactStress { normal: Real, shear: Real }`, `ContactState` an
+/// `array<Real, NSTATE>` of the pair history ([`ContactModel::n_state`], at least one
+/// entry), and the parameters read with `param(p, k)` (k-th entry of `params`). Keep to
+/// + − × ÷, sqrt, abs, min, max (drivers may lack f64 `exp`/`pow`); to match the CPU to
+/// rounding, repeat the CPU arithmetic in the same order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WgslContactModel {
+    /// Identifies the code: laws with equal keys must have equal bodies.
+    pub key: String,
+    /// The WGSL function body.
+    pub body: String,
+    /// Parameters read with `param(p, k)`.
+    pub params: Vec<f64>,
+    /// Body of `fn (c: u32, t: u32, p: u32) -> Real`, the pair's normal penalty (Pa), for
+    /// laws that override [`ContactModel::pair_penalty`]; `None`: the constant
+    /// [`ContactModel::normal_penalty`].
+    pub pair_penalty: Option<String>,
+}
+
+/// x^b for the damping curve: an integer exponent (the usual case, and the only one the
+/// GPU kernel takes) by repeated multiplication, the same operations as the WGSL law.
+fn damping_power(x: f64, b: f64) -> f64 {
+    if b.fract() == 0.0 && (1.0..=64.0).contains(&b) {
+        let mut w = 1.0;
+        for _ in 0..b as u32 {
+            w *= x;
+        }
+        w
+    } else {
+        x.powf(b)
     }
 }
 
@@ -148,7 +223,7 @@ impl ContactModel for MohrCoulombContact {
                     state[2] = s_try.min(d.transition);
                     state[2]
                 } else {
-                    state[2] * (s_try / state[1]).powf(d.exponent)
+                    state[2] * damping_power(s_try / state[1], d.exponent)
                 }
             }
         };
@@ -166,6 +241,164 @@ impl ContactModel for MohrCoulombContact {
             shear = -state[0].signum() * t;
         }
         ContactStress { normal, shear }
+    }
+    fn wgsl(&self) -> Option<WgslContactModel> {
+        let (fr_on, tan_phi, pt) = match self.friction {
+            Some(f) => (1.0, f.angle_deg.to_radians().tan(), f.penalty),
+            None => (0.0, 0.0, 0.0),
+        };
+        let (d_on, t, b) = match self.damping {
+            // The GPU law raises to integer powers only (no f64 `pow` on most drivers).
+            Some(d) if !(d.exponent.fract() == 0.0 && (1.0..=64.0).contains(&d.exponent)) => {
+                return None
+            }
+            Some(d) => (1.0, d.transition, d.exponent),
+            None => (0.0, 0.0, 1.0),
+        };
+        Some(WgslContactModel {
+            key: "contact_m_c".into(),
+            body: include_str!("shaders/mohr_coulomb_contact.wgsl").into(),
+            params: vec![fr_on, tan_phi, pt, d_on, t, b],
+            pair_penalty: None,
+        })
+    }
+}
+
+/// Contact without a contact law (manual table 1): every element's surfaces carry a
+/// friction angle and a contact penalty (`pcdc_mech::Mechanics::surface_properties`:
+/// friction 0 and penalty 10 E unless the material sets them). A pair uses the smaller
+/// of its two elements' values for both (the softer, smoother surface governs; the
+/// manual does not say how two surfaces combine), with the shear penalty equal to the
+/// normal one and no damping: `contact-m-c` with those parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceContact {
+    /// Friction angle per element (degrees).
+    pub friction_deg: Vec<f64>,
+    /// Contact penalty per element (Pa).
+    pub penalty: Vec<f64>,
+}
+
+impl SurfaceContact {
+    /// The `contact-m-c` law of the pair (c, t).
+    fn pair_law(&self, c: usize, t: usize) -> MohrCoulombContact {
+        let p = self.penalty[c].min(self.penalty[t]);
+        MohrCoulombContact {
+            normal_penalty: p,
+            friction: Some(Friction {
+                angle_deg: self.friction_deg[c].min(self.friction_deg[t]),
+                penalty: p,
+            }),
+            damping: None,
+        }
+    }
+}
+
+impl ContactModel for SurfaceContact {
+    fn name(&self) -> &str {
+        "element-surface contact (table 1)"
+    }
+    fn normal_penalty(&self) -> f64 {
+        self.penalty.iter().fold(0.0, |m, &p| m.max(p))
+    }
+    fn n_state(&self) -> usize {
+        3
+    }
+    fn check(&self) -> Result<(), ComputeError> {
+        if self.penalty.len() != self.friction_deg.len() {
+            return Err(ComputeError::param(
+                "surface contact properties",
+                format!(
+                    "{} friction angles, {} penalties",
+                    self.friction_deg.len(),
+                    self.penalty.len()
+                ),
+                "give one friction angle and one penalty per element",
+            ));
+        }
+        for (e, (&phi, &p)) in self.friction_deg.iter().zip(&self.penalty).enumerate() {
+            if !(0.0..90.0).contains(&phi) {
+                return Err(ComputeError::param(
+                    format!("friction angle of element {e}"),
+                    phi,
+                    "must lie in [0, 90) degrees",
+                ));
+            }
+            if !(p > 0.0 && p.is_finite()) {
+                return Err(ComputeError::param(
+                    format!("contact penalty of element {e}"),
+                    p,
+                    "must be positive and finite (Pa)",
+                ));
+            }
+        }
+        Ok(())
+    }
+    fn check_mesh(&self, n_elements: usize) -> Result<(), ComputeError> {
+        if self.penalty.len() != n_elements {
+            return Err(ComputeError::param(
+                "surface contact properties",
+                format!("{} elements", self.penalty.len()),
+                format!("the mesh has {n_elements} elements: give one value per element"),
+            ));
+        }
+        Ok(())
+    }
+    fn pair_penalty(&self, c: usize, t: usize) -> f64 {
+        self.penalty[c].min(self.penalty[t])
+    }
+    /// The law of the elements with the smallest friction and penalty (Contact calls
+    /// [`ContactModel::update_pair`] instead).
+    fn update(&self, s_try: f64, dslip: f64, h: f64, state: &mut [f64]) -> ContactStress {
+        let (c, _) = self
+            .penalty
+            .iter()
+            .enumerate()
+            .fold(
+                (0, f64::INFINITY),
+                |b, (e, &p)| if p < b.1 { (e, p) } else { b },
+            );
+        let f = self
+            .friction_deg
+            .iter()
+            .enumerate()
+            .fold(
+                (0, f64::INFINITY),
+                |b, (e, &p)| if p < b.1 { (e, p) } else { b },
+            )
+            .0;
+        let mut law = self.pair_law(c, c);
+        if let Some(fr) = &mut law.friction {
+            fr.angle_deg = self.friction_deg[f];
+        }
+        law.update(s_try, dslip, h, state)
+    }
+    fn update_pair(
+        &self,
+        c: usize,
+        t: usize,
+        s_try: f64,
+        dslip: f64,
+        h: f64,
+        state: &mut [f64],
+    ) -> ContactStress {
+        self.pair_law(c, t).update(s_try, dslip, h, state)
+    }
+    fn wgsl(&self) -> Option<WgslContactModel> {
+        // Parameters: element count, then tan φ per element, then the penalty per element.
+        let ne = self.penalty.len();
+        let mut params = Vec::with_capacity(1 + 2 * ne);
+        params.push(ne as f64);
+        params.extend(self.friction_deg.iter().map(|a| a.to_radians().tan()));
+        params.extend_from_slice(&self.penalty);
+        Some(WgslContactModel {
+            key: "surface_contact".into(),
+            body: include_str!("shaders/surface_contact.wgsl").into(),
+            params,
+            pair_penalty: Some(
+                "let ne = u32(param(p, 0u));\nreturn min(param(p, 1u + ne + c), param(p, 1u + ne + t));"
+                    .into(),
+            ),
+        })
     }
 }
 

@@ -1,5 +1,6 @@
-//! The 2D contact physics: a sorted-grid broad phase with a skin and element-centric,
-//! deterministic assembly of Munjiza's potential contact force.
+//! The contact physics (2D triangles and 3D tetrahedra): a sorted-grid broad phase with
+//! a skin and element-centric, deterministic assembly of Munjiza's potential contact
+//! force ([`crate::triangle_pair_force`] in 2D, [`crate::tet_pair_force`] in 3D).
 //!
 //! Every element keeps a candidate list of elements whose bounding boxes, inflated by
 //! the skin, overlap its own; the lists are rebuilt when any node has moved more than
@@ -18,7 +19,21 @@
 //! are declared with [`Contact::bonded_pairs`]; the pair becomes a contact pair as soon
 //! as the joint's broken-face flag is set (the cohesive crate publishes it).
 //!
-//! Limitations: 2D only.
+//! The contact law (eq. 59-61) sees per pair a trial normal stress σ_try = |F_n| / A over
+//! a contact measure A, a contact length h and a scalar slip increment:
+//!
+//! - 2D (per unit thickness): A = h, h the mean edge length of the two triangles; the
+//!   tangent is the normal turned counter-clockwise and the slip increment is signed,
+//!   Δδ = v_t Δt.
+//! - 3D: A = h², h the mean edge length of the two tetrahedra (the manual's h is the
+//!   square root of the contact area). The normal n is the direction of the contactor's
+//!   total normal force; the tangential direction is that of the pair's relative
+//!   tangential velocity v_t = v_rel − (v_rel · n) n, and the slip increment is
+//!   Δδ = |v_t| Δt ≥ 0 along it. The accumulated slip δ_s of the law is therefore a
+//!   scalar along the current sliding direction: the shear force min(P_t h |δ_s|,
+//!   tan φ σ_n) h² always opposes the current sliding velocity (purely dissipative, no
+//!   stored tangential spring force when the sliding direction turns), and no shear acts
+//!   while v_t = 0.
 
 use std::sync::Mutex;
 
@@ -32,7 +47,7 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 use crate::model::{ContactDamping, ContactModel, Friction, MohrCoulombContact};
-use crate::triangle_pair_force;
+use crate::{tet_pair_force, triangle_pair_force, PairForce3};
 
 /// Node positions at the last broad-phase build (m), stride D.
 pub const CONTACT_REFERENCE: &str = "contact_reference_positions";
@@ -83,7 +98,7 @@ fn apply_model<D: Dim>(
     let (vc, vt) = (vel(c, &wc), vel(t, &wt));
     let v_rel = (vc[0] - vt[0]) * tang[0] + (vc[1] - vt[1]) * tang[1];
     let s_try = fn_mag / h;
-    let r = model.update(s_try, v_rel * kin.dt, h, state);
+    let r = model.update_pair(c, t, s_try, v_rel * kin.dt, h, state);
     if r.normal != s_try {
         let scale = r.normal / s_try;
         for a in 0..3 {
@@ -104,7 +119,78 @@ fn apply_model<D: Dim>(
     }
 }
 
-/// Potential contact between all elements of the mesh (2D).
+/// The 3D form of [`apply_model`] for a tetrahedron pair: trial stress
+/// σ_try = |F_n| / h², slip increment |v_t| Δt along the relative tangential velocity
+/// v_t of the two tetrahedra (node velocities weighted by each node's share of the
+/// normal force; see the module docs), then the normal forces are scaled to σ_n h² and
+/// the shear force τ h² is added along v_t / |v_t| with the same weights, equal and
+/// opposite on the two tetrahedra.
+fn apply_model3<D: Dim>(
+    pair: &mut crate::PairForce3,
+    kin: &Kinematics<'_, D>,
+    c: usize,
+    t: usize,
+    model: &dyn ContactModel,
+    h: f64,
+    state: &mut [f64],
+) {
+    let fc: [f64; 3] = std::array::from_fn(|d| pair.contactor.iter().map(|v| v[d]).sum::<f64>());
+    let fn_mag = (fc[0] * fc[0] + fc[1] * fc[1] + fc[2] * fc[2]).sqrt();
+    if fn_mag == 0.0 {
+        model.separate(state);
+        return;
+    }
+    let n = fc.map(|x| x / fn_mag);
+    let weights = |forces: &[[f64; 3]; 4]| {
+        let w: [f64; 4] = std::array::from_fn(|a| {
+            let f = forces[a];
+            (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()
+        });
+        let sum: f64 = w.iter().sum();
+        w.map(|x| if sum > 0.0 { x / sum } else { 0.25 })
+    };
+    let (wc, wt) = (weights(&pair.contactor), weights(&pair.target));
+    let vel = |e: usize, w: &[f64; 4]| {
+        let conn = kin.mesh.element(e);
+        let mut v = [0.0; 3];
+        for a in 0..4 {
+            for d in 0..3 {
+                v[d] += w[a] * kin.v[conn[a] as usize * D::D + d];
+            }
+        }
+        v
+    };
+    let (vc, vt) = (vel(c, &wc), vel(t, &wt));
+    let rel: [f64; 3] = std::array::from_fn(|d| vc[d] - vt[d]);
+    let vn = rel[0] * n[0] + rel[1] * n[1] + rel[2] * n[2];
+    let tv: [f64; 3] = std::array::from_fn(|d| rel[d] - vn * n[d]);
+    let vt_mag = (tv[0] * tv[0] + tv[1] * tv[1] + tv[2] * tv[2]).sqrt();
+    let area = h * h;
+    let s_try = fn_mag / area;
+    let r = model.update_pair(c, t, s_try, vt_mag * kin.dt, h, state);
+    if r.normal != s_try {
+        let scale = r.normal / s_try;
+        for a in 0..4 {
+            for k in 0..3 {
+                pair.contactor[a][k] *= scale;
+                pair.target[a][k] *= scale;
+            }
+        }
+    }
+    if r.shear != 0.0 && vt_mag > 0.0 {
+        let ft = r.shear * area;
+        let tang = tv.map(|x| x / vt_mag);
+        for a in 0..4 {
+            for d in 0..3 {
+                pair.contactor[a][d] += wc[a] * ft * tang[d];
+                pair.target[a][d] -= wt[a] * ft * tang[d];
+            }
+        }
+    }
+}
+
+/// Potential contact between all elements of the mesh (triangles in 2D, tetrahedra in
+/// 3D).
 #[derive(Debug)]
 pub struct Contact {
     penalty: f64,
@@ -115,6 +201,7 @@ pub struct Contact {
     model: Option<Arc<dyn ContactModel>>,
     n_state: usize,
     skin: Option<f64>,
+    gpu_capacity: Option<usize>,
     bonds: Option<Bonds>,
     skin_used: f64,
     reference: Option<FieldId>,
@@ -160,6 +247,7 @@ impl Contact {
             model: None,
             n_state: 0,
             skin: None,
+            gpu_capacity: None,
             bonds: None,
             skin_used: 0.0,
             reference: None,
@@ -173,6 +261,18 @@ impl Contact {
     pub fn with_model(mut self, model: impl ContactModel + 'static) -> Self {
         self.custom = Some(Arc::new(model));
         self
+    }
+
+    /// Contact without a contact law (manual table 1): each element's surface friction
+    /// angle (degrees) and contact penalty (Pa), e.g. from
+    /// `pcdc_mech::Mechanics::surface_properties`; a pair takes the smaller of its two
+    /// elements' values ([`crate::SurfaceContact`]). Replaces the penalty given to
+    /// [`Contact::new`]; `friction` and `damping` are ignored.
+    pub fn surface_defaults(self, friction_deg: Vec<f64>, penalty: Vec<f64>) -> Self {
+        self.with_model(crate::SurfaceContact {
+            friction_deg,
+            penalty,
+        })
     }
 
     /// Adds Coulomb friction (eq. 59-60).
@@ -212,6 +312,14 @@ impl Contact {
         self
     }
 
+    /// Candidate-list capacity per element on the GPU (default: twice the largest
+    /// initial list, at least 48); a run that needs more stops with an error naming the
+    /// element.
+    pub fn gpu_capacity(mut self, capacity: usize) -> Self {
+        self.gpu_capacity = Some(capacity);
+        self
+    }
+
     /// Skin distance of the broad phase (m); default half the smallest element edge.
     pub fn skin(mut self, skin: f64) -> Self {
         self.skin = Some(skin);
@@ -227,16 +335,83 @@ impl Contact {
         t
     }
 
+    fn element_xyz<D: Dim>(kin: &Kinematics<'_, D>, e: usize) -> [[f64; 3]; 4] {
+        let c = kin.mesh.element(e);
+        let mut t = [[0.0; 3]; 4];
+        for a in 0..4 {
+            let n = c[a] as usize;
+            t[a] = [kin.x(n, 0), kin.x(n, 1), kin.x(n, 2)];
+        }
+        t
+    }
+
+    /// Critical step of 3D contact. A face of area A of one tetrahedron pressed flat by
+    /// δ into a face of the other, whose height over that face is H, loads each of its
+    /// three nodes with about p (4 δ / H) A / 3 from the target's potential and as much
+    /// again from the reaction of the target face inside the contactor's potential: a
+    /// node stiffness k_e ≈ (8/3) p A / H = (8/9) p A² / V (H = 3 V / A), taken with the
+    /// largest face of the element. A node sums k_e over its elements (conservative for
+    /// nodes shared by a continuous body) and, as in 2D, dt = 2 √(m / (2 k)) for two
+    /// equal masses pressed together.
+    fn stable_step_3d<D: Dim>(kin: &Kinematics<'_, D>, penalty: f64) -> StableStep {
+        let mut k = vec![0.0; kin.mesh.n_nodes()];
+        for e in 0..kin.mesh.n_elements() {
+            let t = Self::element_xyz(kin, e);
+            let edge =
+                |a: usize, b: usize| -> [f64; 3] { std::array::from_fn(|d| t[b][d] - t[a][d]) };
+            let cross = |u: [f64; 3], v: [f64; 3]| {
+                [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ]
+            };
+            let norm = |u: [f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+            let c = cross(edge(0, 2), edge(0, 3));
+            let e1 = edge(0, 1);
+            let vol = (e1[0] * c[0] + e1[1] * c[1] + e1[2] * c[2]).abs() / 6.0;
+            let area_max = [(1, 2, 3), (0, 2, 3), (0, 1, 3), (0, 1, 2)]
+                .iter()
+                .map(|&(a, b, d)| 0.5 * norm(cross(edge(a, b), edge(a, d))))
+                .fold(0.0, f64::max);
+            if vol > 0.0 {
+                let ke = 8.0 / 9.0 * penalty * area_max * area_max / vol;
+                for &n in kin.mesh.element(e) {
+                    k[n as usize] += ke;
+                }
+            }
+        }
+        let (mut best, mut which) = (f64::INFINITY, 0);
+        for (n, (&m, &kn)) in kin.mass.iter().zip(&k).enumerate() {
+            if kn > 0.0 {
+                let dt = 2.0 * (m / (2.0 * kn)).sqrt();
+                if dt < best {
+                    best = dt;
+                    which = n;
+                }
+            }
+        }
+        StableStep {
+            dt: best,
+            entity: format!("contact at node {which}"),
+            physics: "contact".into(),
+        }
+    }
+
     /// Rebuilds the candidate lists: element boxes inflated by half the skin, then the
-    /// sorted grid ([`grid_candidates`]).
+    /// sorted grid ([`grid_candidates`] in 2D, [`grid_candidates_3d`] in 3D).
     fn build<D: Dim>(&self, kin: &Kinematics<'_, D>) -> Vec<Vec<u32>> {
+        if D::D == 3 {
+            let boxes = element_boxes_3d(kin, 0.5 * self.skin_used);
+            return grid_candidates_3d(&boxes, kin.mesh.elements());
+        }
         let boxes = element_boxes(kin, 0.5 * self.skin_used);
         grid_candidates(&boxes, kin.mesh.elements())
     }
 }
 
 /// Axis-aligned boxes `[x_min, y_min, x_max, y_max]` (m) of the current triangles,
-/// inflated by `margin` on every side.
+/// inflated by `margin` on every side (2D meshes; [`element_boxes_3d`] in 3D).
 pub fn element_boxes<D: Dim>(kin: &Kinematics<'_, D>, margin: f64) -> Vec<[f64; 4]> {
     (0..kin.mesh.n_elements())
         .map(|e| {
@@ -362,6 +537,143 @@ pub fn grid_candidates(boxes: &[[f64; 4]], conn: &[u32]) -> Vec<Vec<u32>> {
         .collect()
 }
 
+/// Axis-aligned boxes `[x_min, y_min, z_min, x_max, y_max, z_max]` (m) of the current
+/// tetrahedra of a 3D mesh, inflated by `margin` (m) on every side.
+pub fn element_boxes_3d<D: Dim>(kin: &Kinematics<'_, D>, margin: f64) -> Vec<[f64; 6]> {
+    (0..kin.mesh.n_elements())
+        .map(|e| {
+            let t = Contact::element_xyz(kin, e);
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for p in &t {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k] - margin);
+                    hi[k] = hi[k].max(p[k] + margin);
+                }
+            }
+            [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]]
+        })
+        .collect()
+}
+
+/// The 3D broad phase, as [`grid_candidates`] one dimension up: for every tetrahedron,
+/// the sorted list of tetrahedra whose boxes (from [`element_boxes_3d`]) overlap its own
+/// and that share no node with it (`conn`: 4 nodes per tetrahedron). Boxes are binned on
+/// a uniform grid of cell size = the largest box extent and each box looks in its own
+/// and the 26 neighbouring cells; a dense counting-sort grid for compact domains, sorted
+/// cell keys for scattered bodies. Deterministic.
+pub fn grid_candidates_3d(boxes: &[[f64; 6]], conn: &[u32]) -> Vec<Vec<u32>> {
+    type Key = (i64, i64, i64);
+    let ne = boxes.len();
+    let cell = boxes
+        .iter()
+        .map(|b| (b[3] - b[0]).max(b[4] - b[1]).max(b[5] - b[2]))
+        .fold(0.0f64, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let origin = boxes.iter().fold([f64::INFINITY; 3], |o, b| {
+        [o[0].min(b[0]), o[1].min(b[1]), o[2].min(b[2])]
+    });
+    let coord = |x: f64, k: usize| ((x - origin[k]) / cell).floor() as i64;
+    let keys: Vec<Key> = boxes
+        .iter()
+        .map(|b| {
+            (
+                coord(0.5 * (b[0] + b[3]), 0),
+                coord(0.5 * (b[1] + b[4]), 1),
+                coord(0.5 * (b[2] + b[5]), 2),
+            )
+        })
+        .collect();
+    let (ncx, ncy, ncz) = keys.iter().fold((0i64, 0i64, 0i64), |(a, b, c), k| {
+        (a.max(k.0 + 1), b.max(k.1 + 1), c.max(k.2 + 1))
+    });
+    // Test one candidate pair: boxes overlap and no shared node.
+    let accept = |e: usize, f: usize| -> bool {
+        let (b, o) = (boxes[e], boxes[f]);
+        f != e
+            && !(o[0] > b[3]
+                || b[0] > o[3]
+                || o[1] > b[4]
+                || b[1] > o[4]
+                || o[2] > b[5]
+                || b[2] > o[5])
+            && !conn[4 * f..4 * f + 4]
+                .iter()
+                .any(|n| conn[4 * e..4 * e + 4].contains(n))
+    };
+    if (ncx as u128) * (ncy as u128) * (ncz as u128) <= (4 * ne + 1024) as u128 {
+        // Compact domain: a dense grid, cells filled by counting sort (CSR), O(n).
+        let (nx, ny, nz) = (ncx as usize, ncy as usize, ncz as usize);
+        let cell_of = |k: Key| k.0 as usize + nx * (k.1 as usize + ny * k.2 as usize);
+        let mut start = vec![0u32; nx * ny * nz + 1];
+        for k in &keys {
+            start[cell_of(*k) + 1] += 1;
+        }
+        for c in 0..nx * ny * nz {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; ne];
+        for (e, k) in keys.iter().enumerate() {
+            let c = cell_of(*k);
+            items[fill[c] as usize] = e as u32;
+            fill[c] += 1;
+        }
+        return (0..ne)
+            .into_par_iter()
+            .map(|e| {
+                let (cx, cy, cz) = keys[e];
+                let mut list = Vec::new();
+                for z in (cz - 1).max(0)..=(cz + 1).min(ncz - 1) {
+                    for y in (cy - 1).max(0)..=(cy + 1).min(ncy - 1) {
+                        for x in (cx - 1).max(0)..=(cx + 1).min(ncx - 1) {
+                            let c = cell_of((x, y, z));
+                            for &f in &items[start[c] as usize..start[c + 1] as usize] {
+                                if accept(e, f as usize) {
+                                    list.push(f);
+                                }
+                            }
+                        }
+                    }
+                }
+                list.sort_unstable();
+                list
+            })
+            .collect();
+    }
+    // Scattered bodies: sorted cell keys, binary search.
+    let mut keyed: Vec<(Key, u32)> = keys
+        .iter()
+        .enumerate()
+        .map(|(e, k)| (*k, e as u32))
+        .collect();
+    keyed.sort_unstable();
+    let find = |k: Key| -> &[(Key, u32)] {
+        let start = keyed.partition_point(|x| x.0 < k);
+        let end = keyed.partition_point(|x| x.0 <= k);
+        &keyed[start..end]
+    };
+    (0..ne)
+        .into_par_iter()
+        .map(|e| {
+            let (cx, cy, cz) = keys[e];
+            let mut list = Vec::new();
+            for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        for &(_, f) in find((cx + dx, cy + dy, cz + dz)) {
+                            if accept(e, f as usize) {
+                                list.push(f);
+                            }
+                        }
+                    }
+                }
+            }
+            list.sort_unstable();
+            list
+        })
+        .collect()
+}
+
 impl<D: Dim, B: Backend> Physics<D, B> for Contact {
     fn name(&self) -> &str {
         "contact"
@@ -375,12 +687,6 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
-        if D::D != 2 {
-            return Err(ComputeError::physics(
-                "contact",
-                "3D contact (tetrahedra) is not implemented yet",
-            ));
-        }
         let model: Arc<dyn ContactModel> = match &self.custom {
             Some(m) => m.clone(),
             None => Arc::new(MohrCoulombContact {
@@ -390,6 +696,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
             }),
         };
         model.check()?;
+        model.check_mesh(ctx.mesh.n_elements())?;
         self.n_state = model.n_state();
         self.model = Some(model);
         let (lo, _) = ctx.mesh.edge_length_range();
@@ -446,6 +753,27 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         self.reference = Some(ctx.fields.id(CONTACT_REFERENCE)?);
         ctx.register_slots(ctx.mesh.elements())?;
         Ok(())
+    }
+
+    fn gpu_setup(
+        &mut self,
+        setup: &mut pcdc_compute::gpu::GpuSetup<'_, D>,
+    ) -> Result<(), ComputeError> {
+        let model = self
+            .model
+            .as_deref()
+            .ok_or_else(|| ComputeError::Gpu("contact: GPU setup before init".into()))?;
+        let input = crate::gpu::GpuContactInput {
+            skin: self.skin_used,
+            model,
+            bonds: self
+                .bonds
+                .as_ref()
+                .map(|b| (b.per_element.as_slice(), b.field.as_str())),
+            capacity: self.gpu_capacity,
+            reference: CONTACT_REFERENCE,
+        };
+        crate::gpu::setup(input, setup)
     }
 
     fn save_state(&self) -> Result<Vec<u8>, ComputeError> {
@@ -510,6 +838,9 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
             .model
             .as_ref()
             .map_or(self.penalty, |m| m.normal_penalty());
+        if D::D == 3 {
+            return Some(Self::stable_step_3d(kin, penalty));
+        }
         let (mut best, mut which) = (f64::INFINITY, 0);
         for (n, &m) in kin.mass.iter().enumerate() {
             let dt = 2.0 * (m / (2.0 * 3.0 * penalty)).sqrt();
@@ -532,10 +863,13 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         let reference = ctx.fields.get_mut(rid);
         // Rebuild when any node moved more than half the skin since the last build.
         let limit2 = (0.5 * self.skin_used).powi(2);
+        let dim = D::D;
         let moved = (0..kin.mesh.n_nodes()).any(|n| {
-            let dx = kin.x(n, 0) - reference[2 * n];
-            let dy = kin.x(n, 1) - reference[2 * n + 1];
-            let d2 = dx * dx + dy * dy;
+            let mut d2 = 0.0;
+            for k in 0..dim {
+                let dk = kin.x(n, k) - reference[dim * n + k];
+                d2 += dk * dk;
+            }
             d2.is_nan() || d2 > limit2
         });
         let mut cand = self.candidates.lock().map_err(|_| {
@@ -562,19 +896,72 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
             *cand = fresh;
             *slips = new_slips;
             for n in 0..kin.mesh.n_nodes() {
-                reference[2 * n] = kin.x(n, 0);
-                reference[2 * n + 1] = kin.x(n, 1);
+                for k in 0..dim {
+                    reference[dim * n + k] = kin.x(n, k);
+                }
             }
         }
         let lists = &*cand;
         let slips: &mut Vec<Vec<f64>> = &mut slips;
         let model = self.model.as_deref().expect("init ran");
-        let penalty = model.normal_penalty();
         let bonds = self.bonds.as_ref();
         let broken: &[f64] = match bonds.and_then(|b| b.id) {
             Some(id) => ctx.fields.get(id),
             None => &[],
         };
+        if dim == 3 {
+            // Tetrahedra: 4 nodes x 3 components of slots per element.
+            let mean_edge3 = |e: usize| {
+                let t = Self::element_xyz(kin, e);
+                let mut sum = 0.0;
+                for a in 0..4 {
+                    for b in a + 1..4 {
+                        let d: [f64; 3] = std::array::from_fn(|k| t[b][k] - t[a][k]);
+                        sum += (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    }
+                }
+                sum / 6.0
+            };
+            ctx.backend.install(|| {
+                ctx.slots
+                    .par_chunks_mut(12)
+                    .zip(slips.par_iter_mut())
+                    .enumerate()
+                    .for_each(|(e, (slot, slip))| {
+                        let me = Self::element_xyz(kin, e);
+                        for (k, &f) in lists[e].iter().enumerate() {
+                            let f = f as usize;
+                            if let Some(face) = bonds.and_then(|b| b.face(e, f)) {
+                                if broken[face] == 0.0 {
+                                    continue;
+                                }
+                            }
+                            let other = Self::element_xyz(kin, f);
+                            let (c, t, ci, ti) = if e < f {
+                                (&me, &other, e, f)
+                            } else {
+                                (&other, &me, f, e)
+                            };
+                            let mut pair = tet_pair_force(c, t, model.pair_penalty(ci, ti));
+                            let state = &mut slip[k * ns..(k + 1) * ns];
+                            if pair == PairForce3::default() {
+                                // Not touching (most candidates): no force, fresh history.
+                                model.separate(state);
+                                continue;
+                            }
+                            let h = 0.5 * (mean_edge3(ci) + mean_edge3(ti));
+                            apply_model3(&mut pair, kin, ci, ti, model, h, state);
+                            let share = if e < f { pair.contactor } else { pair.target };
+                            for a in 0..4 {
+                                for d in 0..3 {
+                                    slot[3 * a + d] += share[a][d];
+                                }
+                            }
+                        }
+                    })
+            });
+            return Ok(());
+        }
         let mean_edge = |e: usize| {
             let t = Self::element_xy(kin, e);
             (0..3)
@@ -607,7 +994,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
                         } else {
                             (&other, &me, f, e)
                         };
-                        let mut pair = triangle_pair_force(c, t, penalty);
+                        let mut pair = triangle_pair_force(c, t, model.pair_penalty(ci, ti));
                         let h = 0.5 * (mean_edge(ci) + mean_edge(ti));
                         let state = &mut slip[k * ns..(k + 1) * ns];
                         apply_model(&mut pair, kin, ci, ti, model, h, state);

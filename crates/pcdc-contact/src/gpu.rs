@@ -1,0 +1,361 @@
+//! The contact physics on the GPU (2D): the broad phase as a uniform grid built by
+//! counting sort, and the element-centric pair forces, in WGSL kernels that repeat the
+//! CPU arithmetic in the same order (so f64 results match the CPU to rounding).
+//!
+//! Every step runs, in order (the flag kernels return at once when no rebuild is due):
+//!
+//! 1. `moved` (per node): raise the rebuild flag when a node has moved more than half
+//!    the skin since the last build (the CPU's criterion);
+//! 2. `boxes` (per element): inflated boxes; keep the old candidate lists and history;
+//! 3. `cell` (one invocation): cell size = largest box extent; clear bucket counters;
+//! 4. `count` (per element): bucket of each box centre (cells hashed into a power-of-two
+//!    table), counted with integer atomics;
+//! 5. `scan` (one invocation): prefix sum of the counts;
+//! 6. `scatter` + `candidates` (per element): bucket items, then each element's sorted
+//!    list of overlapping boxes from the 3 × 3 cells around it, with the pair history of
+//!    partners that were already candidates;
+//! 7. `reference` (per node) and `reset` (one invocation): positions of this build, flag
+//!    down;
+//! 8. `forces` (per element): Munjiza's potential force and the contact law for every
+//!    candidate, the element's own share written to its slots.
+//!
+//! Integer atomics count and raise flags; no float atomics. The order inside a bucket
+//! depends on scheduling, but the lists are sorted, so the forces do not.
+//!
+//! Lists have a fixed capacity per element ([`crate::Contact::gpu_capacity`]; default
+//! twice the largest initial list, at least 48): an element that finds more candidates
+//! stops the run with an error naming it. The two single-invocation kernels loop over all
+//! elements and buckets; they run on rebuild steps only.
+//!
+//! Limitations: 2D; the pair history lives on the device (a snapshot of a GPU run holds
+//! the candidate reference positions but not the friction slip, which restarts at zero
+//! after a restore).
+
+use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, Precision};
+use pcdc_compute::ComputeError;
+use pcdc_mesh::Dim;
+
+use crate::model::ContactModel;
+
+const COMMON: &str = include_str!("shaders/broad_common.wgsl");
+const POTENTIAL: &str = include_str!("shaders/potential2d.wgsl");
+
+/// What the contact physics hands to the GPU setup.
+pub(crate) struct GpuContactInput<'a> {
+    /// Skin distance (m).
+    pub skin: f64,
+    /// The law in force.
+    pub model: &'a dyn ContactModel,
+    /// Bonded neighbours per element (neighbour, face), sorted, and the broken-face
+    /// field name.
+    pub bonds: Option<(&'a [Vec<(u32, u32)>], &'a str)>,
+    /// Candidate capacity per element, if set by the user.
+    pub capacity: Option<usize>,
+    /// Name of the reference-position field.
+    pub reference: &'a str,
+}
+
+/// Declares the contact kernels.
+pub(crate) fn setup<D: Dim>(
+    input: GpuContactInput<'_>,
+    setup: &mut GpuSetup<'_, D>,
+) -> Result<(), ComputeError> {
+    if D::D != 2 {
+        return Err(ComputeError::NoGpuKernel {
+            physics: "contact".into(),
+            reason: "3D contact has no GPU kernel yet".into(),
+        });
+    }
+    let model = input.model;
+    let wgsl = model.wgsl().ok_or_else(|| ComputeError::NoGpuKernel {
+        physics: "contact".into(),
+        reason: format!(
+            "contact law '{}' has no WGSL body (implement ContactModel::wgsl; the built-in \
+             contact-m-c needs an integer damping exponent b on the GPU)",
+            model.name()
+        ),
+    })?;
+    let mesh = setup.mesh;
+    let ne = mesh.n_elements();
+    let nn = mesh.n_nodes();
+    if ne == 0 {
+        return Ok(());
+    }
+    let ns = model.n_state().max(1);
+    // Capacity: twice the largest list of the initial configuration, at least 48.
+    let capacity = match input.capacity {
+        Some(c) => c,
+        None => {
+            let margin = 0.5 * input.skin;
+            let x = mesh.coords();
+            let boxes: Vec<[f64; 4]> = mesh
+                .elements()
+                .chunks_exact(3)
+                .map(|c| {
+                    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+                    for &n in c {
+                        for k in 0..2 {
+                            lo[k] = lo[k].min(x[2 * n as usize + k] - margin);
+                            hi[k] = hi[k].max(x[2 * n as usize + k] + margin);
+                        }
+                    }
+                    [lo[0], lo[1], hi[0], hi[1]]
+                })
+                .collect();
+            let lists = crate::grid_candidates(&boxes, mesh.elements());
+            (2 * lists.iter().map(Vec::len).max().unwrap_or(0)).max(48)
+        }
+    };
+    let nbuckets = (2 * ne).next_power_of_two();
+    let splice = splice_models(
+        "contact_model",
+        "s_try: Real, dslip: Real, h: Real, state: ptr<function, ContactState>, p: u32, c: u32, t: u32",
+        "s_try, dslip, h, state, p, c, t",
+        "ContactStress",
+        None,
+        [(wgsl.key.as_str(), wgsl.body.as_str())],
+    );
+
+    let conn = setup.upload("connectivity", GpuData::U32(mesh.elements().to_vec()));
+    let flag = setup.atomics("rebuild flag", 4);
+    let boxes = setup.upload("boxes", GpuData::Real(vec![0.0; 4 * ne]));
+    let grid = setup.upload("grid", GpuData::Real(vec![0.0; 2]));
+    let keys = setup.upload("bucket keys", GpuData::U32(vec![0; ne]));
+    let count = setup.atomics("bucket counts", nbuckets);
+    let fill = setup.atomics("bucket fill", nbuckets);
+    let start = setup.upload("bucket starts", GpuData::U32(vec![0; nbuckets + 1]));
+    let items = setup.upload("bucket items", GpuData::U32(vec![0; ne]));
+    let cand = setup.upload("candidates", GpuData::U32(vec![0; ne * capacity]));
+    let cand_old = setup.upload("old candidates", GpuData::U32(vec![0; ne * capacity]));
+    let ncand = setup.upload("candidate counts", GpuData::U32(vec![0; ne]));
+    let ncand_old = setup.upload("old candidate counts", GpuData::U32(vec![0; ne]));
+    let hist = setup.upload("pair history", GpuData::Real(vec![0.0; ne * capacity * ns]));
+    let hist_old = setup.upload(
+        "old pair history",
+        GpuData::Real(vec![0.0; ne * capacity * ns]),
+    );
+    let model_data = setup.upload("law parameters", GpuData::Real(wgsl.params.clone()));
+    // Bonds as CSR: per element its (neighbour, face) pairs sorted by neighbour.
+    let (bond_ptr, bond_list, broken) = match input.bonds {
+        Some((per, field)) => {
+            let mut ptr = vec![0u32; ne + 1];
+            let mut list = Vec::new();
+            for (e, l) in per.iter().enumerate() {
+                for &(f, face) in l {
+                    list.push(f);
+                    list.push(face);
+                }
+                ptr[e + 1] = (list.len() / 2) as u32;
+            }
+            list.resize(list.len().max(2), 0);
+            (ptr, list, Some(setup.field(field)?))
+        }
+        None => (vec![0u32; ne + 1], vec![0u32; 2], None),
+    };
+    let bond_ptr = setup.upload("bond pointers", GpuData::U32(bond_ptr));
+    let bond_list = setup.upload("bonds", GpuData::U32(bond_list));
+    let broken = match broken {
+        Some(b) => b,
+        None => setup.upload("no bonds", GpuData::Real(vec![0.0])),
+    };
+    let reference = setup.field(input.reference)?;
+    let overflow = setup.error(move |e| {
+        format!(
+            "element {e} has more than {capacity} contact candidates on the GPU; raise \
+             Contact::gpu_capacity"
+        )
+    });
+    let tiny = match setup.precision() {
+        Precision::F64 => f64::MIN_POSITIVE,
+        Precision::F32 => 1e-30,
+    };
+    let half = 0.5 * input.skin;
+    let common = |k: Kernel| {
+        k.const_u32("D", D::D as u32)
+            .const_u32("CAP", capacity as u32)
+            .const_u32("NSTATE", ns as u32)
+            .const_u32("NE", ne as u32)
+            .const_u32("NBUCKETS", nbuckets as u32)
+    };
+    let broad = |label: &str, body: &str, n: usize| {
+        common(Kernel::new(
+            format!("contact {label}"),
+            format!("{COMMON}{body}"),
+            n,
+        ))
+        .bind("flag", flag, Access::ReadWrite)
+    };
+    let kernels = [
+        broad("moved", include_str!("shaders/broad_moved.wgsl"), nn)
+            .const_real("LIMIT2", half * half)
+            .bind("coords", setup.coords(), Access::Read)
+            .bind("disp", setup.displacement(), Access::Read)
+            .bind("reference", reference, Access::Read),
+        broad("boxes", include_str!("shaders/broad_boxes.wgsl"), ne)
+            .const_real("MARGIN", half)
+            .bind("coords", setup.coords(), Access::Read)
+            .bind("disp", setup.displacement(), Access::Read)
+            .bind("conn", conn, Access::Read)
+            .bind("boxes", boxes, Access::ReadWrite)
+            .bind("cand", cand, Access::Read)
+            .bind("ncand", ncand, Access::Read)
+            .bind("hist", hist, Access::Read)
+            .bind("cand_old", cand_old, Access::ReadWrite)
+            .bind("ncand_old", ncand_old, Access::ReadWrite)
+            .bind("hist_old", hist_old, Access::ReadWrite),
+        broad("cell", include_str!("shaders/broad_cell.wgsl"), 1)
+            .const_real("REAL_TINY", tiny)
+            .bind("boxes", boxes, Access::Read)
+            .bind("grid", grid, Access::ReadWrite)
+            .bind("bucket_count", count, Access::ReadWrite),
+        broad("count", include_str!("shaders/broad_count.wgsl"), ne)
+            .bind("boxes", boxes, Access::Read)
+            .bind("grid", grid, Access::Read)
+            .bind("keys", keys, Access::ReadWrite)
+            .bind("bucket_count", count, Access::ReadWrite),
+        broad("scan", include_str!("shaders/broad_scan.wgsl"), 1)
+            .bind("bucket_count", count, Access::ReadWrite)
+            .bind("bucket_fill", fill, Access::ReadWrite)
+            .bind("bucket_start", start, Access::ReadWrite),
+        broad("scatter", include_str!("shaders/broad_scatter.wgsl"), ne)
+            .bind("keys", keys, Access::Read)
+            .bind("bucket_fill", fill, Access::ReadWrite)
+            .bind("bucket_start", start, Access::Read)
+            .bind("bucket_items", items, Access::ReadWrite),
+        broad(
+            "candidates",
+            include_str!("shaders/broad_candidates.wgsl"),
+            ne,
+        )
+        .const_u32("OVERFLOW_CODE", overflow)
+        .bind("conn", conn, Access::Read)
+        .bind("boxes", boxes, Access::Read)
+        .bind("grid", grid, Access::Read)
+        .bind("bucket_start", start, Access::Read)
+        .bind("bucket_items", items, Access::Read)
+        .bind("cand", cand, Access::ReadWrite)
+        .bind("ncand", ncand, Access::ReadWrite)
+        .bind("hist", hist, Access::ReadWrite)
+        .bind("cand_old", cand_old, Access::Read)
+        .bind("ncand_old", ncand_old, Access::Read)
+        .bind("hist_old", hist_old, Access::Read)
+        .bind("status", setup.status(), Access::ReadWrite),
+        broad("reference", include_str!("shaders/broad_reference.wgsl"), nn)
+            .bind("coords", setup.coords(), Access::Read)
+            .bind("disp", setup.displacement(), Access::Read)
+            .bind("reference", reference, Access::ReadWrite),
+        broad("reset", include_str!("shaders/broad_reset.wgsl"), 1),
+        common(Kernel::new(
+            "contact forces",
+            format!(
+                "alias ContactState = array<Real, NSTATE>;\nstruct ContactStress {{\n    normal: Real,\n    shear: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return model_data[p + k]; }}\nfn pair_penalty(c: u32, t: u32, p: u32) -> Real {{\n{}\n}}\n{POTENTIAL}{}{}",
+                wgsl.pair_penalty.as_deref().unwrap_or("return PENALTY;"),
+                splice.source,
+                include_str!("shaders/contact_forces.wgsl")
+            ),
+            ne,
+        ))
+        .const_u32("SLOT_FIRST", setup.slot_first())
+        .const_u32("MODEL_KIND", splice.kinds[0])
+        .const_u32("MODEL_AT", 0)
+        .const_real("PENALTY", model.normal_penalty())
+        .const_real("GAUSS_0", 0.5 - 0.5 / 3f64.sqrt())
+        .const_real("GAUSS_1", 0.5 + 0.5 / 3f64.sqrt())
+        .bind("coords", setup.coords(), Access::Read)
+        .bind("disp", setup.displacement(), Access::Read)
+        .bind("vel", setup.velocity(), Access::Read)
+        .bind("conn", conn, Access::Read)
+        .bind("cand", cand, Access::Read)
+        .bind("ncand", ncand, Access::Read)
+        .bind("hist", hist, Access::ReadWrite)
+        .bind("bond_ptr", bond_ptr, Access::Read)
+        .bind("bond_list", bond_list, Access::Read)
+        .bind("broken", broken, Access::Read)
+        .bind("model_data", model_data, Access::Read)
+        .bind("slots", setup.slots(), Access::ReadWrite),
+    ];
+    for k in kernels {
+        setup.kernel(Phase::Forces, k)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Contact, ContactModel, ContactStress};
+    use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
+    use pcdc_compute::{ComputeError, CpuBackend, Physics, Precision};
+    use pcdc_mesh::{builders, Dim2, Mesh};
+
+    fn two_blocks() -> Mesh<Dim2> {
+        let a = builders::rectangle(0.0, 0.0, 0.1, 0.1, 0.02).unwrap();
+        let b = builders::rectangle(0.102, 0.0, 0.1, 0.1, 0.02).unwrap();
+        builders::union(&[&a, &b]).unwrap().0
+    }
+
+    fn sources(contact: Contact, p: Precision) -> Result<Vec<(String, String)>, ComputeError> {
+        let physics: Vec<Box<dyn Physics<Dim2, CpuBackend>>> = vec![Box::new(contact)];
+        offline_kernel_sources(&two_blocks(), physics, p)
+    }
+
+    /// Every contact kernel (with friction and damping) validates with naga, f64 and f32.
+    #[test]
+    fn contact_kernels_validate() {
+        for p in [Precision::F64, Precision::F32] {
+            let contact = Contact::new(1e10).friction(30.0, 1e11).damping(1e6, 2.0);
+            let all = sources(contact, p).unwrap();
+            let ours: Vec<_> = all
+                .iter()
+                .filter(|(l, _)| l.starts_with("contact"))
+                .collect();
+            assert_eq!(
+                ours.len(),
+                10,
+                "{:?}",
+                all.iter().map(|k| &k.0).collect::<Vec<_>>()
+            );
+            for (label, src) in ours {
+                if let Err(e) = validate_wgsl(src) {
+                    panic!("{label} ({p:?}) does not validate:\n{e}");
+                }
+            }
+        }
+    }
+
+    #[derive(Debug)]
+    struct CpuOnly;
+    impl ContactModel for CpuOnly {
+        fn name(&self) -> &str {
+            "cpu-only-contact"
+        }
+        fn normal_penalty(&self) -> f64 {
+            1e10
+        }
+        fn update(&self, s_try: f64, _: f64, _: f64, _: &mut [f64]) -> ContactStress {
+            ContactStress {
+                normal: s_try,
+                shear: 0.0,
+            }
+        }
+    }
+
+    /// A law without WGSL, or a damping exponent the GPU law cannot raise to, is a
+    /// build-time error naming the law, never a silent fallback.
+    #[test]
+    fn laws_without_gpu_code_are_named() {
+        for (contact, what) in [
+            (Contact::new(1e10).with_model(CpuOnly), "cpu-only-contact"),
+            (
+                Contact::new(1e10).damping(1e6, 2.5),
+                "integer damping exponent",
+            ),
+        ] {
+            match sources(contact, Precision::F64) {
+                Err(e @ ComputeError::NoGpuKernel { .. }) => {
+                    assert!(e.to_string().contains(what), "{e}")
+                }
+                other => panic!("expected NoGpuKernel, got {:?}", other.map(|_| ())),
+            }
+        }
+    }
+}

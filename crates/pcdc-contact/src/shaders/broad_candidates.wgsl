@@ -1,0 +1,94 @@
+// Broad phase, step 6b (one invocation per element, only when rebuilding): the sorted
+// list of elements whose boxes overlap this one's and that share no node with it (the
+// same test as the CPU's `grid_candidates`), from the buckets of the 3 x 3 cells around
+// its box centre; then the pair history of partners that were already candidates.
+fn shares_node(e: u32, f: u32) -> bool {
+    for (var a = 0u; a < 3u; a = a + 1u) {
+        let n = conn[3u * f + a];
+        if n == conn[3u * e] || n == conn[3u * e + 1u] || n == conn[3u * e + 2u] {
+            return true;
+        }
+    }
+    return false;
+}
+
+fn overlaps(e: u32, f: u32) -> bool {
+    return !(boxes[4u * f] > boxes[4u * e + 2u] || boxes[4u * e] > boxes[4u * f + 2u]
+        || boxes[4u * f + 1u] > boxes[4u * e + 3u] || boxes[4u * e + 1u] > boxes[4u * f + 3u]);
+}
+
+fn kernel(e: u32) {
+    if atomicLoad(&flag[0]) == 0u {
+        return;
+    }
+    let cell = grid[0];
+    let cx = cell_of(Real(0.5) * (boxes[4u * e] + boxes[4u * e + 2u]), cell);
+    let cy = cell_of(Real(0.5) * (boxes[4u * e + 1u] + boxes[4u * e + 3u]), cell);
+    var seen: array<u32, 9>;
+    var nseen = 0u;
+    var list: array<u32, CAP>;
+    var n = 0u;
+    var overflow = false;
+    for (var dy = -1; dy <= 1; dy = dy + 1) {
+        for (var dx = -1; dx <= 1; dx = dx + 1) {
+            let b = bucket(cx + dx, cy + dy);
+            // Two cells may hash to one bucket: visit each bucket once.
+            var dup = false;
+            for (var s = 0u; s < nseen; s = s + 1u) {
+                dup = dup || seen[s] == b;
+            }
+            if dup {
+                continue;
+            }
+            seen[nseen] = b;
+            nseen = nseen + 1u;
+            for (var j = bucket_start[b]; j < bucket_start[b + 1u]; j = j + 1u) {
+                let f = bucket_items[j];
+                if f == e || !overlaps(e, f) || shares_node(e, f) {
+                    continue;
+                }
+                if n == CAP {
+                    overflow = true;
+                    continue;
+                }
+                // Insertion into the sorted list.
+                var at = n;
+                while at > 0u && list[at - 1u] > f {
+                    list[at] = list[at - 1u];
+                    at = at - 1u;
+                }
+                list[at] = f;
+                n = n + 1u;
+            }
+        }
+    }
+    if overflow {
+        atomicMin(&status[2], OVERFLOW_CODE);
+        atomicMin(&status[3], e);
+    }
+    let n_old = ncand_old[e];
+    for (var k = 0u; k < n; k = k + 1u) {
+        let f = list[k];
+        cand[e * CAP + k] = f;
+        // Binary search of the partner in the old (sorted) list.
+        var lo = 0u;
+        var hi = n_old;
+        while lo < hi {
+            let mid = (lo + hi) / 2u;
+            if cand_old[e * CAP + mid] < f {
+                lo = mid + 1u;
+            } else {
+                hi = mid;
+            }
+        }
+        let found = lo < n_old && cand_old[e * CAP + lo] == f;
+        for (var s = 0u; s < NSTATE; s = s + 1u) {
+            var v = Real(0.0);
+            if found {
+                v = hist_old[(e * CAP + lo) * NSTATE + s];
+            }
+            hist[(e * CAP + k) * NSTATE + s] = v;
+        }
+    }
+    ncand[e] = n;
+}

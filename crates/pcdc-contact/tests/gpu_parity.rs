@@ -1,0 +1,202 @@
+//! CPU–GPU parity of the contact physics (2D): one scene body, instantiated for
+//! `CpuBackend::new(1)` and the GPU backend.
+//!
+//! Scenes: (1) two elastic blocks collide obliquely, one spinning, with Coulomb friction
+//! (the stick and slip branches run) and contact damping (loading cap and unloading
+//! curve), over enough steps that the candidate lists are rebuilt many times and pair
+//! histories are carried across rebuilds; (2) an FDEM block (every triangle with its own
+//! nodes, cohesive joints between them, declared as bonded pairs) hits a second block
+//! hard enough that joints break and their faces become contact faces.
+//!
+//! Measured and compared: displacement and velocity (f64: max |Δu| / max |u| ≤ 1e-12).
+//! Fracture amplifies any rounding difference: in the FDEM scene the CPU is also run
+//! with its initial velocities perturbed by 1e-15 (relative), and the bar is four times
+//! the drift that causes (as in the cohesive parity tests).
+//! Without a GPU adapter the tests skip (and fail with PCDC_REQUIRE_GPU=1).
+
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE};
+use pcdc_compute::gpu::gpu_test_backend;
+use pcdc_compute::{Backend, CpuBackend, Precision, Simulation};
+use pcdc_contact::Contact;
+use pcdc_mech::{LinearElastic, Mechanics};
+use pcdc_mesh::{builders, Dim2, Mesh, Range};
+
+const E: f64 = 1e9;
+/// Impact speed of the FDEM block (m/s).
+const SPEED: f64 = 3.0;
+
+fn two_blocks(gap: f64) -> Mesh<Dim2> {
+    let a = builders::rectangle(0.0, 0.0, 0.1, 0.1, 0.02).unwrap();
+    let b = builders::rectangle(0.1 + gap, 0.03, 0.1, 0.1, 0.02).unwrap();
+    builders::union(&[&a, &b]).unwrap().0
+}
+
+struct Outcome {
+    u: Vec<f64>,
+    v: Vec<f64>,
+    broken: usize,
+}
+
+/// Scene 1: oblique, spinning, frictional and damped impact.
+fn impact<B: Backend>(backend: B) -> Outcome {
+    let mesh = two_blocks(0.002);
+    let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
+    let contact = Contact::new(10.0 * E)
+        .friction(30.0, 50.0 * E)
+        .damping(2e6, 2.0);
+    let mut sim = Simulation::builder(mesh, backend)
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(contact)
+        .build()
+        .unwrap();
+    let x = sim.mesh().coords().to_vec();
+    // Left block: 2 m/s to the right, 0.5 m/s up, spinning at 20 rad/s about its centre.
+    for n in 0..sim.mesh().n_nodes() {
+        if x[2 * n] < 0.101 {
+            let (rx, ry) = (x[2 * n] - 0.05, x[2 * n + 1] - 0.05);
+            sim.state.v[2 * n] = 2.0 - 20.0 * ry;
+            sim.state.v[2 * n + 1] = 0.5 + 20.0 * rx;
+        }
+    }
+    // Approach (1 ms), contact with sliding, rebound; in two runs (state carried over).
+    let steps = (3e-3 / sim.dt()).ceil() as u64;
+    sim.run(steps / 2).unwrap();
+    sim.run(steps - steps / 2).unwrap();
+    Outcome {
+        u: sim.state.u.clone(),
+        v: sim.state.v.clone(),
+        broken: 0,
+    }
+}
+
+/// Scene 2: an FDEM block with bonded pairs hits a second block; joints break.
+fn fdem<B: Backend>(backend: B, perturb: f64) -> Outcome {
+    let a = builders::rectangle(0.0, 0.0, 0.06, 0.06, 0.01).unwrap();
+    let b = builders::rectangle(0.061, -0.02, 0.04, 0.1, 0.01).unwrap();
+    let mesh = builders::union(&[&a, &b]).unwrap().0;
+    let left = Range::rect(-1.0, -1.0, 0.0605, 1.0);
+    let split = split_nodes(&mesh, &left).unwrap();
+    let czm = IntrinsicCzm::new(30.0, 4e6, 2e6, 0.01, 0.1, 10.0 * E, 10.0 * E, 10.0 * E).unwrap();
+    let joints = CohesiveJoints::new(split.joints.clone()).model(Range::All, czm);
+    let bond_faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
+    let contact = Contact::new(10.0 * E)
+        .friction(20.0, 10.0 * E)
+        .bonded_pairs(&split.joints.elements, &bond_faces, BROKEN_FACE);
+    let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
+    let mut sim = Simulation::builder(split.mesh.clone(), backend)
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(joints)
+        .physics(contact)
+        .build()
+        .unwrap();
+    let x = sim.mesh().coords().to_vec();
+    for n in 0..sim.mesh().n_nodes() {
+        if x[2 * n] < 0.0605 {
+            sim.state.v[2 * n] = SPEED * (1.0 + perturb * (n as f64 * 0.618_033_988_7).fract());
+        }
+    }
+    let steps = (1e-3 / sim.dt()).ceil() as u64;
+    sim.run(steps).unwrap();
+    let broken = sim
+        .field(BROKEN_FACE)
+        .unwrap()
+        .iter()
+        .filter(|&&f| f != 0.0)
+        .count();
+    Outcome {
+        u: sim.state.u.clone(),
+        v: sim.state.v.clone(),
+        broken,
+    }
+}
+
+fn max_abs(a: &[f64]) -> f64 {
+    a.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// Compares displacement and velocity (each relative to its largest magnitude); `tol`
+/// bounds (u, v).
+fn compare(name: &str, cpu: &Outcome, gpu: &Outcome, tol: (f64, f64)) {
+    let du = max_diff(&cpu.u, &gpu.u) / max_abs(&cpu.u);
+    let dv = max_diff(&cpu.v, &gpu.v) / max_abs(&cpu.v);
+    println!(
+        "{name}: max|du|/max|u| = {du:.2e}, max|dv|/max|v| = {dv:.2e}, broken faces cpu {} gpu {}",
+        cpu.broken, gpu.broken
+    );
+    assert!(
+        du <= tol.0 && dv <= tol.1,
+        "{name}: du {du:e}, dv {dv:e} above {tol:?}"
+    );
+}
+
+#[test]
+fn frictional_damped_impact_matches_cpu_f64() {
+    let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
+        return;
+    };
+    let cpu = impact(CpuBackend::new(1).unwrap());
+    let reads = gpu.readbacks();
+    let dev = impact(gpu.clone());
+    // One read-back per run() call.
+    assert_eq!(gpu.readbacks() - reads, 2);
+    compare("impact f64", &cpu, &dev, (1e-12, 1e-11));
+}
+
+#[test]
+fn fdem_block_breaking_on_impact_matches_cpu_f64() {
+    let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
+        return;
+    };
+    let cpu = fdem(CpuBackend::new(1).unwrap(), 0.0);
+    assert!(
+        cpu.broken > 0,
+        "no joint broke: the scene does not test bonded pairs"
+    );
+    // Fracture amplifies rounding: the CPU itself, with the initial velocities perturbed
+    // by 1e-15 (relative), drifts this far; the bar is four times that drift.
+    let perturbed = fdem(CpuBackend::new(1).unwrap(), 1e-15);
+    let drift_u = max_diff(&cpu.u, &perturbed.u) / max_abs(&cpu.u);
+    let drift_v = max_diff(&cpu.v, &perturbed.v) / max_abs(&cpu.v);
+    println!("fdem: CPU drift under a 1e-15 perturbation: u {drift_u:.2e}, v {drift_v:.2e}");
+    let dev = fdem(gpu, 0.0);
+    assert_eq!(cpu.broken, dev.broken);
+    compare(
+        "fdem f64",
+        &cpu,
+        &dev,
+        ((4.0 * drift_u).max(1e-12), (4.0 * drift_v).max(1e-11)),
+    );
+}
+
+#[test]
+fn impact_f32_is_close() {
+    let Some(gpu) = gpu_test_backend(Some(Precision::F32)) else {
+        return;
+    };
+    let cpu = impact(CpuBackend::new(1).unwrap());
+    let dev = impact(gpu);
+    // Measured and printed; bounded loosely (single precision, a frictional impact).
+    compare("impact f32", &cpu, &dev, (2e-2, 2e-2));
+}
+
+#[test]
+fn candidate_overflow_is_an_error_naming_the_element() {
+    let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
+        return;
+    };
+    let mesh = two_blocks(0.002);
+    let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
+    let mut sim = Simulation::builder(mesh, gpu)
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(Contact::new(10.0 * E).gpu_capacity(2))
+        .build()
+        .unwrap();
+    let e = sim.run(1).unwrap_err().to_string();
+    assert!(e.contains("element") && e.contains("gpu_capacity"), "{e}");
+}
