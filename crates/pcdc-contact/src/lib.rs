@@ -1,12 +1,15 @@
 //! # pcdc-contact
 //!
 //! Contact between finite elements for the pcdc-rs FDEM SDK (manual 7.3), after
-//! Munjiza's potential contact: the exact 2D normal contact force between two
-//! overlapping triangles ([`triangle_pair_force`], eq. 52-58), the [`ContactModel`]
-//! plugin trait with the built-in `contact-m-c` law ([`MohrCoulombContact`]: Coulomb
-//! friction with a shear penalty, eq. 59-60, and damping after An and Tannant, eq. 61),
-//! and the [`Contact`] physics (sorted-grid broad phase with a skin, deterministic
-//! element-centric assembly, bonded-neighbour exclusion for FDEM regions).
+//! Munjiza's potential contact: the exact normal contact force between two overlapping
+//! triangles in 2D ([`triangle_pair_force`], eq. 52-58) and between two overlapping
+//! tetrahedra in 3D ([`tet_pair_force`], the same equations one dimension up), the
+//! [`ContactModel`] plugin trait with the built-in `contact-m-c` law
+//! ([`MohrCoulombContact`]: Coulomb friction with a shear penalty, eq. 59-60, and damping
+//! after An and Tannant, eq. 61), and the [`Contact`] physics for `Mesh<Dim2>` and
+//! `Mesh<Dim3>` (sorted-grid broad phase with a skin, deterministic element-centric
+//! assembly, bonded-neighbour exclusion for FDEM regions). 3D contact runs on the CPU
+//! backend; the GPU kernels are 2D.
 //!
 //! Contact without a contact law uses the elements' own surface friction and penalty
 //! (manual table 1): [`Contact::surface_defaults`] with [`SurfaceContact`].

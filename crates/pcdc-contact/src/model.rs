@@ -3,8 +3,10 @@
 //!
 //! The contact physics computes, per element pair, the normal force of Munjiza's
 //! potential with the model's normal penalty (eq. 52-58); it turns it into a trial
-//! normal stress σ_try = |F_n| / h over the contact length h (per unit thickness in 2D)
-//! and the relative tangential velocity into a slip increment Δδ = v_t Δt. The model
+//! normal stress σ_try = |F_n| / h over the contact length h (per unit thickness in 2D;
+//! σ_try = |F_n| / h² in 3D) and the relative tangential velocity into a slip increment
+//! Δδ = v_t Δt (in 3D Δδ = |v_t| Δt ≥ 0 along the current sliding direction, so the
+//! accumulated slip is a scalar along that direction; see the physics docs). The model
 //! returns the normal and shear contact stresses and updates the pair's history.
 
 use std::fmt::Debug;
@@ -41,7 +43,8 @@ pub trait ContactModel: Send + Sync + Debug {
         Ok(())
     }
     /// Contact stresses of a touching pair from the trial normal stress `s_try` (Pa,
-    /// positive), the tangential slip increment `dslip` over the step (m) and the
+    /// positive), the tangential slip increment `dslip` over the step (m; signed along
+    /// the tangent in 2D, non-negative along the current sliding direction in 3D) and the
     /// contact length `h` (m); `state` holds [`ContactModel::n_state`] values.
     fn update(&self, s_try: f64, dslip: f64, h: f64, state: &mut [f64]) -> ContactStress;
     /// Normal penalty for the pair of elements `c` (contactor) and `t` (target) (Pa);
