@@ -1,9 +1,16 @@
 //! Validation scenes of `VALIDATION.md`: each runs a model, compares it with a closed
 //! form and returns the measured error. Examples run them at full size and print the
 //! `RESULT` line; tests run them at reduced size and assert the same tolerance.
+//!
+//! The laboratory tests [`ucs`] and [`brazilian`] share one platen-test set-up
+//! ([`platen_test`]) and can be written as TOML scene files ([`file`]).
 
 pub mod block_sliding;
+pub mod brazilian;
 pub mod direct_tension;
+pub mod file;
 pub mod kirsch;
+pub mod platen_test;
+pub mod ucs;
 pub mod vibration_energy;
 pub mod wave_speed;

@@ -1,0 +1,809 @@
+//! The laboratory test shared by the UCS ([`crate::scenes::ucs`]) and Brazilian
+//! ([`crate::scenes::brazilian`]) scenes: a rock specimen with a cohesive joint on every
+//! interior face (manual 7.4), pressed between two elastic steel platens that move
+//! towards each other at a prescribed velocity, with potential contact (manual 7.3)
+//! between the platens and the specimen and on the faces of broken joints.
+//!
+//! The parameter groups are `serde` types that read and write TOML (see
+//! [`crate::scenes::file`]); every group rejects unknown keys and every value is
+//! checked by `validate`, which names the offending key. Units are SI throughout.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use pcdc_cohesive::{
+    czm_state, split_nodes, CohesiveJoints, FailureMode, IntrinsicCzm, BROKEN_FACE, JOINT_DAMAGE,
+    JOINT_STATE,
+};
+use pcdc_compute::{Backend, Simulation, Table, TimeValue};
+use pcdc_contact::Contact;
+use pcdc_mech::{output, Boundary, LinearElastic, Mechanics};
+use pcdc_mesh::vtu::{DataArray, PvdSeries};
+use pcdc_mesh::{builders, Dim2, Mesh, Range};
+
+use crate::report::SceneError;
+
+/// A parameter value that is out of range: names the key (as written in a scene file,
+/// e.g. `rock.poisson`), the value and what is allowed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{key} = {value}: {reason}")]
+pub struct ParamError {
+    /// Key path in the scene file, e.g. `sample.height`.
+    pub key: String,
+    /// The rejected value.
+    pub value: f64,
+    /// What the key accepts.
+    pub reason: &'static str,
+}
+
+/// Checks that `value` is positive and finite.
+pub(crate) fn positive(key: &str, value: f64) -> Result<(), ParamError> {
+    if value > 0.0 && value.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError {
+            key: key.into(),
+            value,
+            reason: "must be positive and finite",
+        })
+    }
+}
+
+/// Checks that `value` lies in `[lo, hi)`.
+pub(crate) fn within(
+    key: &str,
+    value: f64,
+    lo: f64,
+    hi: f64,
+    reason: &'static str,
+) -> Result<(), ParamError> {
+    if value >= lo && value < hi {
+        Ok(())
+    } else {
+        Err(ParamError {
+            key: key.into(),
+            value,
+            reason,
+        })
+    }
+}
+
+/// Elastic rock of the specimen (linear elastic, plane strain; manual 7.2.3) with the
+/// element viscous damping of eq. 17-19.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Rock {
+    /// Young's modulus E (Pa).
+    pub young: f64,
+    /// Poisson's ratio ν, in [0, 0.5).
+    pub poisson: f64,
+    /// Density ρ (kg/m³).
+    pub density: f64,
+    /// Damping factor D_f of eq. 19 (fraction of the element-scale critical damping).
+    pub damping: f64,
+}
+
+impl Default for Rock {
+    /// E = 30 GPa, ν = 0.25, ρ = 2600 kg/m³ (the manual's quick start does not give them),
+    /// D_f = 0.5.
+    fn default() -> Self {
+        Rock {
+            young: 30e9,
+            poisson: 0.25,
+            density: 2600.0,
+            damping: 0.5,
+        }
+    }
+}
+
+impl Rock {
+    fn validate(&self, key: &str) -> Result<(), ParamError> {
+        positive(&format!("{key}.young"), self.young)?;
+        within(
+            &format!("{key}.poisson"),
+            self.poisson,
+            0.0,
+            0.5,
+            "must lie in [0, 0.5)",
+        )?;
+        positive(&format!("{key}.density"), self.density)?;
+        within(
+            &format!("{key}.damping"),
+            self.damping,
+            0.0,
+            f64::INFINITY,
+            "must be non-negative and finite",
+        )
+    }
+
+    fn model(&self) -> Result<LinearElastic, SceneError> {
+        Ok(LinearElastic::new(self.young, self.poisson, self.density)?
+            .with_damping(self.damping)?)
+    }
+}
+
+/// The two steel platens: rectangles centred on the specimen's axis, one below and one
+/// above it, elastic (pure FEM, shared nodes: they do not crack).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Platens {
+    /// Platen height (m).
+    pub height: f64,
+    /// Platen width (m).
+    pub width: f64,
+    /// Young's modulus (Pa).
+    pub young: f64,
+    /// Poisson's ratio.
+    pub poisson: f64,
+    /// Density (kg/m³).
+    pub density: f64,
+}
+
+impl Default for Platens {
+    /// The manual's quick start: 10 × 56 mm; steel E = 200 GPa, ν = 0.3, ρ = 7800 kg/m³.
+    fn default() -> Self {
+        Platens {
+            height: 0.010,
+            width: 0.056,
+            young: 200e9,
+            poisson: 0.3,
+            density: 7800.0,
+        }
+    }
+}
+
+impl Platens {
+    fn validate(&self) -> Result<(), ParamError> {
+        positive("platens.height", self.height)?;
+        positive("platens.width", self.width)?;
+        positive("platens.young", self.young)?;
+        within(
+            "platens.poisson",
+            self.poisson,
+            0.0,
+            0.5,
+            "must lie in [0, 0.5)",
+        )?;
+        positive("platens.density", self.density)
+    }
+}
+
+/// Intrinsic cohesive joints on every interior face of the specimen (manual 7.4.2,
+/// table 9). Penalties are given as multiples of the rock's Young's modulus, as in the
+/// manual's quick-start script (`m_s_mod*10`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct JointParams {
+    /// Friction angle φ (degrees), in [0, 90).
+    pub friction_deg: f64,
+    /// Cohesion c (Pa).
+    pub cohesion: f64,
+    /// Tensile strength T_s (Pa).
+    pub tensile_strength: f64,
+    /// Mode I fracture energy G_f1 (N/m).
+    pub gf1: f64,
+    /// Mode II fracture energy G_f2 (N/m).
+    pub gf2: f64,
+    /// Normal (opening) penalty P_open as a multiple of the rock's E.
+    pub penalty_normal: f64,
+    /// Shear penalty P_tan as a multiple of the rock's E.
+    pub penalty_shear: f64,
+    /// Overlap penalty P_overlap as a multiple of the rock's E.
+    pub penalty_overlap: f64,
+}
+
+impl Default for JointParams {
+    /// The manual's quick start (figure 5): φ = 30°, c = 10 MPa, T_s = 2 MPa,
+    /// G_f1 = 0.5 N/m (500 µN/mm), G_f2 = 5 N/m, penalties 10 E, 10 E and 100 E.
+    fn default() -> Self {
+        JointParams {
+            friction_deg: 30.0,
+            cohesion: 10e6,
+            tensile_strength: 2e6,
+            gf1: 0.5,
+            gf2: 5.0,
+            penalty_normal: 10.0,
+            penalty_shear: 10.0,
+            penalty_overlap: 100.0,
+        }
+    }
+}
+
+impl JointParams {
+    fn validate(&self) -> Result<(), ParamError> {
+        within(
+            "joints.friction_deg",
+            self.friction_deg,
+            0.0,
+            90.0,
+            "must lie in [0, 90) degrees",
+        )?;
+        positive("joints.cohesion", self.cohesion)?;
+        positive("joints.tensile_strength", self.tensile_strength)?;
+        positive("joints.gf1", self.gf1)?;
+        positive("joints.gf2", self.gf2)?;
+        positive("joints.penalty_normal", self.penalty_normal)?;
+        positive("joints.penalty_shear", self.penalty_shear)?;
+        positive("joints.penalty_overlap", self.penalty_overlap)
+    }
+
+    /// The intrinsic CZM for a rock of Young's modulus `young` (Pa).
+    pub fn model(&self, young: f64) -> Result<IntrinsicCzm, SceneError> {
+        Ok(IntrinsicCzm::new(
+            self.friction_deg,
+            self.cohesion,
+            self.tensile_strength,
+            self.gf1,
+            self.gf2,
+            self.penalty_normal * young,
+            self.penalty_shear * young,
+            self.penalty_overlap * young,
+        )?)
+    }
+}
+
+/// Potential contact (manual 7.3, `contact-m-c`) between the platens and the specimen
+/// and between the faces of broken joints.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContactParams {
+    /// Normal and shear penalty as a multiple of the rock's E.
+    pub penalty: f64,
+    /// Coulomb friction angle (degrees), in [0, 90).
+    pub friction_deg: f64,
+}
+
+impl Default for ContactParams {
+    /// Penalty 10 E (the manual's default), friction 30° (the joints' φ).
+    fn default() -> Self {
+        ContactParams {
+            penalty: 10.0,
+            friction_deg: 30.0,
+        }
+    }
+}
+
+impl ContactParams {
+    fn validate(&self) -> Result<(), ParamError> {
+        positive("contact.penalty", self.penalty)?;
+        within(
+            "contact.friction_deg",
+            self.friction_deg,
+            0.0,
+            90.0,
+            "must lie in [0, 90) degrees",
+        )
+    }
+}
+
+/// Loading by platen velocity and when to stop. The defaults differ between the scenes,
+/// so a `[loading]` table in a scene file gives all its keys.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Loading {
+    /// Speed of each platen towards the specimen (m/s); the platens close at twice this.
+    pub platen_velocity: f64,
+    /// Time over which the platen speed ramps up linearly from zero (s): no loading shock.
+    pub ramp_time: f64,
+    /// After the peak, stop once the load has fallen below this fraction of it, in (0, 1).
+    pub stop_fraction: f64,
+    /// Stop anyway once the platens have closed by this fraction of the specimen height.
+    pub max_closure: f64,
+    /// Steps per recorded sample of the load history (the load is averaged over them).
+    pub record_every: u64,
+}
+
+impl Loading {
+    fn validate(&self) -> Result<(), ParamError> {
+        positive("loading.platen_velocity", self.platen_velocity)?;
+        within(
+            "loading.ramp_time",
+            self.ramp_time,
+            0.0,
+            f64::INFINITY,
+            "must be non-negative and finite",
+        )?;
+        within(
+            "loading.stop_fraction",
+            self.stop_fraction,
+            f64::MIN_POSITIVE,
+            1.0,
+            "must lie in (0, 1)",
+        )?;
+        within(
+            "loading.max_closure",
+            self.max_closure,
+            f64::MIN_POSITIVE,
+            1.0,
+            "must lie in (0, 1)",
+        )?;
+        within(
+            "loading.record_every",
+            self.record_every as f64,
+            1.0,
+            1e9,
+            "must be at least 1",
+        )
+    }
+}
+
+/// What to write. The defaults differ between the scenes, so an `[output]` table in a
+/// scene file gives all its keys.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Output {
+    /// Folder of the outputs (CSV, PNG, VTU/PVD); relative to the working directory.
+    pub dir: PathBuf,
+    /// VTU frames over the longest possible run (up to `loading.max_closure`); a run
+    /// that stops at failure writes fewer, and its last state is always written
+    /// (0: no VTU series).
+    pub frames: u32,
+}
+
+impl Output {
+    fn validate(&self) -> Result<(), ParamError> {
+        within(
+            "output.frames",
+            self.frames as f64,
+            0.0,
+            1e5,
+            "must be at most 100000",
+        )
+    }
+}
+
+/// Validates the groups shared by both scenes.
+pub(crate) fn validate_common(
+    rock: &Rock,
+    platens: &Platens,
+    joints: &JointParams,
+    contact: &ContactParams,
+    loading: &Loading,
+    output: &Output,
+) -> Result<(), ParamError> {
+    rock.validate("rock")?;
+    platens.validate()?;
+    joints.validate()?;
+    contact.validate()?;
+    loading.validate()?;
+    output.validate()
+}
+
+/// Progress of a running test, reported every recorded sample.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Steps done.
+    pub step: u64,
+    /// Upper bound on the steps (reached if the specimen never fails).
+    pub max_steps: u64,
+    /// Platen closure so far (m).
+    pub closure: f64,
+    /// Current load per unit thickness (N/m), compression positive.
+    pub load: f64,
+    /// Largest load so far (N/m).
+    pub peak: f64,
+}
+
+/// One recorded sample of the load history (averages over `record_every` steps).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Sample {
+    /// Time (s).
+    pub time: f64,
+    /// Closure of the platens' loaded edges (m).
+    pub closure: f64,
+    /// Shortening of the specimen between its top and bottom nodes (m).
+    pub shortening: f64,
+    /// Load per unit thickness (N/m): mean of the top and bottom platen reactions,
+    /// compression positive.
+    pub load: f64,
+    /// Kinetic energy of the specimen's nodes (J/m).
+    pub kinetic: f64,
+    /// Elastic strain energy of all elements (J/m).
+    pub strain_energy: f64,
+}
+
+/// Broken joints by failure mode (the mode the cohesive model records when D reaches 1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BrokenCount {
+    /// Opening (mode I).
+    pub tensile: usize,
+    /// Sliding (mode II).
+    pub shear: usize,
+    /// Mixed I-II.
+    pub mixed: usize,
+}
+
+impl BrokenCount {
+    /// All broken joints.
+    pub fn total(&self) -> usize {
+        self.tensile + self.shear + self.mixed
+    }
+}
+
+/// A broken joint: midpoint (m) and failure mode.
+#[derive(Clone, Copy, Debug)]
+pub struct Crack {
+    /// Midpoint of the joint in the undeformed mesh (m).
+    pub at: [f64; 2],
+    /// Failure mode.
+    pub mode: FailureMode,
+}
+
+/// What a platen test measured.
+#[derive(Clone, Debug)]
+pub struct Raw {
+    /// The load history.
+    pub samples: Vec<Sample>,
+    /// Index of the peak sample.
+    pub peak_index: usize,
+    /// Broken joints by mode at the end.
+    pub broken: BrokenCount,
+    /// Broken joints at the end.
+    pub cracks: Vec<Crack>,
+    /// Elements (specimen and platens).
+    pub elements: usize,
+    /// Elements of the specimen.
+    pub specimen_elements: usize,
+    /// Joints.
+    pub joints: usize,
+    /// Steps.
+    pub steps: u64,
+    /// Time step (s).
+    pub dt: f64,
+    /// What limits the time step, e.g. `cohesive joints: joint 12`.
+    pub dt_limit: String,
+    /// Wall time (s).
+    pub wall_s: f64,
+    /// The `.pvd` file of the VTU series, if written.
+    pub pvd: Option<PathBuf>,
+}
+
+/// The specimen and the test set-up.
+pub(crate) struct Setup<'a> {
+    /// Specimen mesh (one body, shared nodes); it is split into FDEM elements here.
+    pub specimen: Mesh<Dim2>,
+    /// Element size (m), also used for the platens.
+    pub size: f64,
+    pub rock: &'a Rock,
+    pub platens: &'a Platens,
+    pub joints: &'a JointParams,
+    pub contact: &'a ContactParams,
+    pub loading: &'a Loading,
+    pub output: &'a Output,
+    /// Base name of the VTU series.
+    pub name: &'a str,
+}
+
+/// Runs the platen test: builds specimen + platens, splits the specimen into FDEM
+/// elements with joints, loads by platen velocity until the load has dropped to
+/// `stop_fraction` of its peak (or the closure limit) and reports the history.
+pub(crate) fn run<B: Backend>(
+    backend: &B,
+    s: &Setup<'_>,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<Raw, SceneError> {
+    let start = Instant::now();
+    let (lo, hi) = s.specimen.bounding_box();
+    let (y0, y1) = (lo[1], hi[1]);
+    let height = y1 - y0;
+    let xc = 0.5 * (lo[0] + hi[0]);
+    let (pw, ph) = (s.platens.width, s.platens.height);
+    // The platens touch the specimen's lowest and highest points; their elements are of
+    // the specimen's size (at most the platen height).
+    let size = s.size.min(ph);
+    let bottom = builders::rectangle(xc - 0.5 * pw, y0 - ph, pw, ph, size)?;
+    let top = builders::rectangle(xc - 0.5 * pw, y1, pw, ph, size)?;
+    let n_spec = s.specimen.n_elements();
+    let (joined, _) = builders::union(&[&s.specimen, &bottom, &top])?;
+    // FDEM region: the specimen's elements (centroids strictly between the platens).
+    let eps = 1e-9 * height;
+    let in_specimen = Range::rect(f64::NEG_INFINITY, y0 + eps, f64::INFINITY, y1 - eps);
+    let split = split_nodes(&joined, &in_specimen)?;
+    let mesh = split.mesh;
+    let joints = split.joints;
+    let ne = mesh.n_elements();
+    // Nodes by body (element order is kept by the union and the split).
+    let nodes_of = |r: std::ops::Range<usize>| {
+        let mut v: Vec<u32> = r.flat_map(|e| mesh.element(e).to_vec()).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    let spec_nodes = nodes_of(0..n_spec);
+    let n_bottom = bottom.n_elements();
+    let bottom_nodes = nodes_of(n_spec..n_spec + n_bottom);
+    let top_nodes = nodes_of(n_spec + n_bottom..ne);
+    let at_y = |list: &[u32], y: f64| -> Vec<u32> {
+        list.iter()
+            .copied()
+            .filter(|&n| (mesh.node(n as usize)[1] - y).abs() <= eps)
+            .collect()
+    };
+    let loaded_bottom = at_y(&bottom_nodes, y0 - ph);
+    let loaded_top = at_y(&top_nodes, y1 + ph);
+    let spec_top = at_y(&spec_nodes, y1);
+    let spec_bottom = at_y(&spec_nodes, y0);
+    if loaded_bottom.is_empty() || loaded_top.is_empty() || spec_top.is_empty() {
+        return Err(SceneError::Measurement(
+            "platen test: no loaded or measured nodes found".into(),
+        ));
+    }
+    let mut mesh = mesh;
+    mesh.add_node_group("platen_bottom_edge", loaded_bottom.clone())?;
+    mesh.add_node_group("platen_top_edge", loaded_top.clone())?;
+
+    let e = s.rock.young;
+    let rock = s.rock.model()?;
+    let steel = Rock {
+        young: s.platens.young,
+        poisson: s.platens.poisson,
+        density: s.platens.density,
+        damping: s.rock.damping,
+    }
+    .model()?;
+    let czm = s.joints.model(e)?;
+    let bond_elements = joints.elements.clone();
+    let bond_faces: Vec<u32> = joints.faces.iter().step_by(2).copied().collect();
+    let contact = Contact::new(s.contact.penalty * e)
+        .friction(s.contact.friction_deg, s.contact.penalty * e)
+        .bonded_pairs(&bond_elements, &bond_faces, BROKEN_FACE);
+    let v = s.loading.platen_velocity;
+    let ramp = s.loading.ramp_time.max(0.0);
+    let table = |sign: f64| -> Result<TimeValue, pcdc_compute::ComputeError> {
+        if ramp > 0.0 {
+            Table::new("platen velocity", &[(0.0, 0.0), (ramp, sign * v)]).map(Into::into)
+        } else {
+            Ok((sign * v).into())
+        }
+    };
+    let mut sim = Simulation::builder(mesh, backend.clone())
+        .physics(
+            Mechanics::new()
+                .material(Range::All, rock)
+                .material(in_specimen.clone().complement(), steel),
+        )
+        .physics(CohesiveJoints::new(joints.clone()).model(Range::All, czm))
+        .physics(contact)
+        .physics(
+            Boundary::new()
+                .velocity(
+                    Range::group("platen_bottom_edge"),
+                    [Some(0.0.into()), Some(table(1.0)?), None],
+                )
+                .velocity(
+                    Range::group("platen_top_edge"),
+                    [Some(0.0.into()), Some(table(-1.0)?), None],
+                ),
+        )
+        .build()?;
+    let dt = sim.dt();
+    let dt_limit = sim
+        .time_step_limit()
+        .map(|l| format!("{}: {}", l.physics, l.entity))
+        .unwrap_or_default();
+    // Time to close by max_closure · height, plus the ramp's lost travel.
+    let t_max = s.loading.max_closure * height / (2.0 * v) + 0.5 * ramp;
+    let max_steps = (t_max / dt).ceil() as u64;
+    let every = s.loading.record_every.max(1);
+    let mut series = if s.output.frames > 0 {
+        Some(PvdSeries::new(&s.output.dir, s.name)?)
+    } else {
+        None
+    };
+    // Frames: evenly over the longest possible run; a run that stops at failure writes
+    // fewer, and the last state is always written.
+    let frame_every = (max_steps / u64::from(s.output.frames.max(1))).max(every);
+    let mean_y = |sim: &Simulation<Dim2, B>, list: &[u32]| {
+        list.iter()
+            .map(|&n| sim.state.u[2 * n as usize + 1])
+            .sum::<f64>()
+            / list.len().max(1) as f64
+    };
+    let mut samples = Vec::new();
+    let (mut acc, mut count) = (0.0, 0u64);
+    let (mut peak, mut peak_index) = (0.0f64, 0usize);
+    loop {
+        sim.step()?;
+        let f = sim.node_force();
+        // Reactions: the gathered force on the held edge nodes is what the specimen and
+        // platen push back with; compression pushes the bottom edge down (−y) and the top
+        // edge up (+y).
+        let rb: f64 = loaded_bottom.iter().map(|&n| -f[2 * n as usize + 1]).sum();
+        let rt: f64 = loaded_top.iter().map(|&n| f[2 * n as usize + 1]).sum();
+        acc += 0.5 * (rb + rt);
+        count += 1;
+        let step = sim.state.step;
+        if step % every == 0 {
+            let load = acc / count as f64;
+            (acc, count) = (0.0, 0);
+            let closure = mean_y(&sim, &loaded_bottom) - mean_y(&sim, &loaded_top);
+            let shortening = mean_y(&sim, &spec_bottom) - mean_y(&sim, &spec_top);
+            let mass = sim.mass();
+            let kinetic = 0.5
+                * spec_nodes
+                    .iter()
+                    .map(|&n| {
+                        let n = n as usize;
+                        mass[n] * (sim.state.v[2 * n].powi(2) + sim.state.v[2 * n + 1].powi(2))
+                    })
+                    .sum::<f64>();
+            samples.push(Sample {
+                time: sim.state.time,
+                closure,
+                shortening,
+                load,
+                kinetic,
+                strain_energy: sim.stored_energy(),
+            });
+            if load > peak {
+                peak = load;
+                peak_index = samples.len() - 1;
+            }
+            progress(&Progress {
+                step,
+                max_steps,
+                closure,
+                load,
+                peak,
+            });
+            let failed = peak > 0.0
+                && load < s.loading.stop_fraction * peak
+                && samples.len() > peak_index + 1;
+            if failed || step >= max_steps {
+                break;
+            }
+        }
+        if let Some(series) = series.as_mut() {
+            if step % frame_every == 0 {
+                write_frame(series, &sim, &joints)?;
+            }
+        }
+    }
+    let pvd = match series.as_mut() {
+        Some(series) => {
+            write_frame(series, &sim, &joints)?;
+            Some(series.pvd_path())
+        }
+        None => None,
+    };
+    let (broken, cracks) = broken_joints(&sim, &joints)?;
+    Ok(Raw {
+        samples,
+        peak_index,
+        broken,
+        cracks,
+        elements: ne,
+        specimen_elements: n_spec,
+        joints: joints.len(),
+        steps: sim.state.step,
+        dt,
+        dt_limit,
+        wall_s: start.elapsed().as_secs_f64(),
+        pvd,
+    })
+}
+
+/// Broken joints (D = 1) by failure mode and where they are. A joint's mode is that of
+/// the first of its Gauss points that broke with a recorded mode.
+fn broken_joints<B: Backend>(
+    sim: &Simulation<Dim2, B>,
+    joints: &pcdc_cohesive::Joints,
+) -> Result<(BrokenCount, Vec<Crack>), SceneError> {
+    let damage = sim.field(JOINT_DAMAGE)?;
+    let state = sim.field(JOINT_STATE)?;
+    let nj = joints.len();
+    let stride = if nj > 0 { state.len() / nj } else { 0 };
+    let mut count = BrokenCount::default();
+    let mut cracks = Vec::new();
+    for (j, &d) in damage.iter().enumerate() {
+        if d < 1.0 {
+            continue;
+        }
+        let st = &state[j * stride..(j + 1) * stride];
+        let mode = st
+            .chunks_exact(czm_state::LEN)
+            .map(|g| FailureMode::from_code(g[czm_state::MODE]))
+            .find(|m| *m != FailureMode::Intact)
+            .unwrap_or(FailureMode::Mixed);
+        match mode {
+            FailureMode::Tensile => count.tensile += 1,
+            FailureMode::Shear => count.shear += 1,
+            _ => count.mixed += 1,
+        }
+        let n = &joints.nodes[4 * j..4 * j + 2];
+        let (a, b) = (
+            sim.mesh().node(n[0] as usize),
+            sim.mesh().node(n[1] as usize),
+        );
+        cracks.push(Crack {
+            at: [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])],
+            mode,
+        });
+    }
+    Ok((count, cracks))
+}
+
+/// One VTU frame: displacement, velocity (points); stress, σ1, largest joint damage and
+/// number of broken joints per element (cells).
+fn write_frame<B: Backend>(
+    series: &mut PvdSeries,
+    sim: &Simulation<Dim2, B>,
+    joints: &pcdc_cohesive::Joints,
+) -> Result<(), SceneError> {
+    let damage = sim.field(JOINT_DAMAGE)?;
+    let ne = sim.mesh().n_elements();
+    let mut elem_damage = vec![0.0; ne];
+    let mut elem_broken = vec![0i32; ne];
+    for (j, &d) in damage.iter().enumerate() {
+        for &e in &joints.elements[2 * j..2 * j + 2] {
+            let e = e as usize;
+            elem_damage[e] = f64::max(elem_damage[e], d);
+            if d >= 1.0 {
+                elem_broken[e] += 1;
+            }
+        }
+    }
+    let stress = output::global_stress(sim)?;
+    let principal = output::principal_stress::<Dim2>(&stress);
+    let sigma_1: Vec<f64> = principal.iter().step_by(2).copied().collect();
+    let x = sim.positions();
+    series.write_step(
+        sim.state.time,
+        sim.mesh(),
+        Some(&x),
+        &[
+            DataArray::Vector {
+                name: "displacement",
+                values: &sim.state.u,
+            },
+            DataArray::Vector {
+                name: "velocity",
+                values: &sim.state.v,
+            },
+        ],
+        &[
+            DataArray::SymTensor {
+                name: "stress",
+                values: &stress,
+            },
+            DataArray::Scalar {
+                name: "sigma_1",
+                values: &sigma_1,
+            },
+            DataArray::Scalar {
+                name: "joint_damage_max",
+                values: &elem_damage,
+            },
+            DataArray::Int {
+                name: "broken_joints",
+                values: &elem_broken,
+            },
+        ],
+    )?;
+    Ok(())
+}
+
+/// Writes the load history as CSV: one row per sample.
+pub(crate) fn write_csv(
+    path: &std::path::Path,
+    header: &str,
+    rows: impl Iterator<Item = Vec<f64>>,
+) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(w, "{header}")?;
+    for r in rows {
+        let line: Vec<String> = r.iter().map(|v| format!("{v:.9e}")).collect();
+        writeln!(w, "{}", line.join(","))?;
+    }
+    w.flush()
+}
+
+impl From<ParamError> for SceneError {
+    /// A bad scene parameter is reported as an invalid parameter that names its key.
+    fn from(e: ParamError) -> Self {
+        SceneError::Compute(pcdc_compute::ComputeError::param(e.key, e.value, e.reason))
+    }
+}

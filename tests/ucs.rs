@@ -1,0 +1,56 @@
+//! Reduced-size UCS test (validation scene 8): 4 mm mesh, platens at 0.1 m/s. The
+//! modulus from the linear part must equal the closed-form modulus of the jointed
+//! sample within 2 %, UCS / T_s must lie in 5–20, and the peak must be a finite,
+//! positive strength after which the sample softens.
+
+use pcdc::compute::CpuBackend;
+use pcdc::scenes::ucs;
+
+#[test]
+fn reduced_ucs_modulus_within_tolerance_and_finite_peak() {
+    let cpu = CpuBackend::new(2).unwrap();
+    let p = ucs::Params::reduced();
+    let out = ucs::run(&cpu, &p, &mut |_| {}).unwrap();
+    eprintln!(
+        "ucs reduced: UCS {:.3} MPa, UCS/Ts {:.2}, E {:.3} GPa (error {:.2} %), E from platens {:.3} GPa, strain at peak {:.3e}, KE/SE {:.2e}, broken {:?}, elements {}, steps {}, dt {:.3e} ({}), wall {:.1} s",
+        out.ucs / 1e6,
+        out.ratio,
+        out.young / 1e9,
+        100.0 * out.modulus_error,
+        out.young_from_platens / 1e9,
+        out.strain_at_peak,
+        out.ke_ratio,
+        out.broken,
+        out.elements,
+        out.steps,
+        out.dt,
+        out.dt_limit,
+        out.wall_s
+    );
+    assert!(out.ucs.is_finite() && out.ucs > 0.0, "peak {}", out.ucs);
+    // The modulus of the jointed sample: the closed form of the mesh's joint families in
+    // series with the elements (the joint penalties of 10 E make the sample about 5-6 %
+    // softer than the input E; see ucs::jointed_modulus).
+    let expected = ucs::jointed_modulus(&p);
+    let dev = (out.young - expected).abs() / expected;
+    eprintln!(
+        "jointed closed form {:.3} GPa ({:.2} % below the input E); measured deviates {:.2} %",
+        expected / 1e9,
+        100.0 * (1.0 - expected / p.rock.young),
+        100.0 * dev
+    );
+    assert!(
+        dev <= 0.02,
+        "E = {} vs jointed closed form {expected}",
+        out.young
+    );
+    assert!(out.ratio_in_band(), "UCS / Ts = {}", out.ratio);
+    // The run went past the peak: the last stress is below it and joints broke.
+    let last = *out.stress.last().unwrap();
+    assert!(
+        last < out.ucs,
+        "no softening after the peak: {last} vs {}",
+        out.ucs
+    );
+    assert!(out.broken.total() > 0, "no joint broke");
+}
