@@ -1065,4 +1065,70 @@ mod tests {
             }
         }
     }
+
+    proptest! {
+        /// 3D: friction never exceeds tan φ times the normal force, opposes the relative
+        /// tangential velocity of the contactor, and action equals reaction.
+        #[test]
+        fn friction_3d_bounded_and_opposing(dx in -0.3f64..0.3, dy in -0.3f64..0.3, depth in 0.02f64..0.2,
+                                            vx in -2.0f64..2.0, vy in -2.0f64..2.0, vz in -0.5f64..0.5, phi in 5.0f64..60.0) {
+            // Target: its top face in z = 0; contactor: its bottom face `depth` below.
+            let coords = vec![
+                0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.6, 0.6, -1.5,
+                dx, dy, -depth, 2.0 + dx, dy, -depth, dx, 2.0 + dy, -depth, 0.6 + dx, 0.6 + dy, 1.5 - depth,
+            ];
+            let mesh = Mesh::<pcdc_mesh::Dim3>::new_reoriented(coords, vec![0, 1, 2, 3, 4, 5, 6, 7]).unwrap();
+            let u = vec![0.0; 24];
+            let mut v = vec![0.0; 24];
+            for n in 4..8 {
+                v[3 * n] = vx;
+                v[3 * n + 1] = vy;
+                v[3 * n + 2] = vz;
+            }
+            let mass = vec![1.0; 8];
+            let kin = Kinematics { mesh: &mesh, mass: &mass, u: &u, v: &v, time: 0.0, dt: 1e-3, step: 0, damping: false };
+            let c = Contact::element_xyz(&kin, 1);
+            let t = Contact::element_xyz(&kin, 0);
+            let law = MohrCoulombContact {
+                normal_penalty: 1e9,
+                friction: Some(Friction { angle_deg: phi, penalty: 1e12 }),
+                damping: None,
+            };
+            let sum = |p: &[[f64; 3]; 4]| -> [f64; 3] { std::array::from_fn(|d| p.iter().map(|f| f[d]).sum::<f64>()) };
+            let mut state = [0.0; 3];
+            for _ in 0..50 {
+                let normal = tet_pair_force(&c, &t, 1e9);
+                prop_assume!(normal.contactor.iter().any(|f| f.iter().any(|&x| x != 0.0)));
+                let mut pair = normal;
+                apply_model3(&mut pair, &kin, 1, 0, &law, 1.0, &mut state);
+                let (fn_, all) = (sum(&normal.contactor), sum(&pair.contactor));
+                let ft: [f64; 3] = std::array::from_fn(|d| all[d] - fn_[d]);
+                let n_mag = (fn_[0] * fn_[0] + fn_[1] * fn_[1] + fn_[2] * fn_[2]).sqrt();
+                let t_mag = (ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]).sqrt();
+                prop_assert!(t_mag <= phi.to_radians().tan() * n_mag * (1.0 + 1e-12));
+                // Tangential part of the relative velocity (contactor minus target).
+                let nn = fn_.map(|x| x / n_mag);
+                let vn = vx * nn[0] + vy * nn[1] + vz * nn[2];
+                let vt = [vx - vn * nn[0], vy - vn * nn[1], vz - vn * nn[2]];
+                prop_assert!(ft[0] * vt[0] + ft[1] * vt[1] + ft[2] * vt[2] <= 1e-9 * t_mag.max(1.0), "friction {:?} along sliding {:?}", ft, vt);
+                // Friction is tangential: no component along the normal.
+                prop_assert!((ft[0] * nn[0] + ft[1] * nn[1] + ft[2] * nn[2]).abs() <= 1e-9 * n_mag);
+                let (tc, tt) = (sum(&pair.contactor), sum(&pair.target));
+                for d in 0..3 {
+                    prop_assert!((tc[d] + tt[d]).abs() < 1e-9 * n_mag);
+                }
+            }
+            // Sliding long enough reaches the Coulomb limit.
+            let speed = (vx * vx + vy * vy).sqrt();
+            if speed > 0.5 {
+                let normal = tet_pair_force(&c, &t, 1e9);
+                let mut pair = normal;
+                apply_model3(&mut pair, &kin, 1, 0, &law, 1.0, &mut state);
+                let (fn_, all) = (sum(&normal.contactor), sum(&pair.contactor));
+                let n_mag = (fn_[0] * fn_[0] + fn_[1] * fn_[1] + fn_[2] * fn_[2]).sqrt();
+                let t_mag = (0..3).map(|d| (all[d] - fn_[d]).powi(2)).sum::<f64>().sqrt();
+                prop_assert!((t_mag - phi.to_radians().tan() * n_mag).abs() <= 1e-9 * n_mag, "{} vs {}", t_mag, phi.to_radians().tan() * n_mag);
+            }
+        }
+    }
 }
