@@ -2,21 +2,22 @@
 //! counting sort, and the element-centric pair forces, in WGSL kernels that repeat the
 //! CPU arithmetic in the same order (so f64 results match the CPU to rounding).
 //!
-//! Every step runs, in order (the flag kernels return at once when no rebuild is due):
+//! Every step runs, in order (the rebuild kernels return at once when no rebuild is
+//! due; the rebuild flags alternate with the step's parity):
 //!
 //! 1. `moved` (per node): raise the rebuild flag when a node has moved more than half
-//!    the skin since the last build (the CPU's criterion);
-//! 2. `boxes` (per element): inflated boxes; keep the old candidate lists and history;
-//! 3. `cell` (one invocation): cell size = largest box extent; clear bucket counters;
-//! 4. `count` (per element): bucket of each box centre (cells hashed into a power-of-two
-//!    table), counted with integer atomics;
-//! 5. `scan` (one invocation): prefix sum of the counts;
-//! 6. `scatter` + `candidates` (per element): bucket items, then each element's sorted
+//!    the skin since the last build (the CPU's criterion); lower the other step's flag;
+//! 2. `boxes` (per element): inflated boxes, the largest extent (integer atomicMax on the
+//!    bits of an f32 rounded up); keep the old candidate lists and history;
+//! 3. `count` (per element): bucket of each box centre on the grid of cell size = largest
+//!    extent (cells hashed into a power-of-two table), counted with integer atomics;
+//! 4. `scan` (one invocation): prefix sum of the counts, counters cleared for the next
+//!    build;
+//! 5. `scatter` + `candidates` (per element): bucket items, then each element's sorted
 //!    list of overlapping boxes from the 3 × 3 cells around it, with the pair history of
 //!    partners that were already candidates;
-//! 7. `reference` (per node) and `reset` (one invocation): positions of this build, flag
-//!    down;
-//! 8. `forces` (per element): Munjiza's potential force and the contact law for every
+//! 6. `reference` (per node): positions of this build;
+//! 7. `forces` (per element): Munjiza's potential force and the contact law for every
 //!    candidate, the element's own share written to its slots.
 //!
 //! Integer atomics count and raise flags; no float atomics. The order inside a bucket
@@ -24,8 +25,8 @@
 //!
 //! Lists have a fixed capacity per element ([`crate::Contact::gpu_capacity`]; default
 //! twice the largest initial list, at least 48): an element that finds more candidates
-//! stops the run with an error naming it. The two single-invocation kernels loop over all
-//! elements and buckets; they run on rebuild steps only.
+//! stops the run with an error naming it. The single-invocation `scan` loops over all
+//! buckets; it runs on rebuild steps only.
 //!
 //! Limitations: 2D; the pair history lives on the device (a snapshot of a GPU run holds
 //! the candidate reference positions but not the friction slip, which restarts at zero
@@ -117,9 +118,10 @@ pub(crate) fn setup<D: Dim>(
     );
 
     let conn = setup.upload("connectivity", GpuData::U32(mesh.elements().to_vec()));
-    let flag = setup.atomics("rebuild flag", 4);
+    let flag = setup.atomics("rebuild flags", 2);
+    let cell_bits = setup.atomics("largest box extent", 1);
     let boxes = setup.upload("boxes", GpuData::Real(vec![0.0; 4 * ne]));
-    let grid = setup.upload("grid", GpuData::Real(vec![0.0; 2]));
+    let grid = setup.upload("cell size", GpuData::Real(vec![0.0; 1]));
     let keys = setup.upload("bucket keys", GpuData::U32(vec![0; ne]));
     let count = setup.atomics("bucket counts", nbuckets);
     let fill = setup.atomics("bucket fill", nbuckets);
@@ -197,23 +199,23 @@ pub(crate) fn setup<D: Dim>(
             .bind("disp", setup.displacement(), Access::Read)
             .bind("conn", conn, Access::Read)
             .bind("boxes", boxes, Access::ReadWrite)
+            .bind("cell_bits", cell_bits, Access::ReadWrite)
             .bind("cand", cand, Access::Read)
             .bind("ncand", ncand, Access::Read)
             .bind("hist", hist, Access::Read)
             .bind("cand_old", cand_old, Access::ReadWrite)
             .bind("ncand_old", ncand_old, Access::ReadWrite)
             .bind("hist_old", hist_old, Access::ReadWrite),
-        broad("cell", include_str!("shaders/broad_cell.wgsl"), 1)
+        broad("count", include_str!("shaders/broad_count.wgsl"), ne)
             .const_real("REAL_TINY", tiny)
             .bind("boxes", boxes, Access::Read)
-            .bind("grid", grid, Access::ReadWrite)
-            .bind("bucket_count", count, Access::ReadWrite),
-        broad("count", include_str!("shaders/broad_count.wgsl"), ne)
-            .bind("boxes", boxes, Access::Read)
-            .bind("grid", grid, Access::Read)
+            .bind("cell_bits", cell_bits, Access::ReadWrite)
             .bind("keys", keys, Access::ReadWrite)
             .bind("bucket_count", count, Access::ReadWrite),
         broad("scan", include_str!("shaders/broad_scan.wgsl"), 1)
+            .const_real("REAL_TINY", tiny)
+            .bind("cell_bits", cell_bits, Access::ReadWrite)
+            .bind("grid", grid, Access::ReadWrite)
             .bind("bucket_count", count, Access::ReadWrite)
             .bind("bucket_fill", fill, Access::ReadWrite)
             .bind("bucket_start", start, Access::ReadWrite),
@@ -244,7 +246,6 @@ pub(crate) fn setup<D: Dim>(
             .bind("coords", setup.coords(), Access::Read)
             .bind("disp", setup.displacement(), Access::Read)
             .bind("reference", reference, Access::ReadWrite),
-        broad("reset", include_str!("shaders/broad_reset.wgsl"), 1),
         common(Kernel::new(
             "contact forces",
             format!(
@@ -310,7 +311,7 @@ mod tests {
                 .collect();
             assert_eq!(
                 ours.len(),
-                10,
+                8,
                 "{:?}",
                 all.iter().map(|k| &k.0).collect::<Vec<_>>()
             );

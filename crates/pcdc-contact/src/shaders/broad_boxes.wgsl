@@ -1,8 +1,9 @@
 // Broad phase, step 2 (one invocation per element, only when rebuilding): the element's
-// box inflated by MARGIN, and a copy of its old candidate list and pair history (the
-// history of pairs that stay candidates is carried over in step 6).
+// box inflated by MARGIN; the largest box extent, as the bits of an f32 rounded up
+// (positive floats order like their bits), by an integer atomicMax; and a copy of the
+// element's old candidate list and pair history (carried over in step 5).
 fn kernel(e: u32) {
-    if atomicLoad(&flag[0]) == 0u {
+    if atomicLoad(&flag[p_step() & 1u]) == 0u {
         return;
     }
     var lo = array<Real, 2>(REAL_MAX, REAL_MAX);
@@ -19,6 +20,12 @@ fn kernel(e: u32) {
     boxes[4u * e + 1u] = lo[1];
     boxes[4u * e + 2u] = hi[0];
     boxes[4u * e + 3u] = hi[1];
+    let ext = max(hi[0] - lo[0], hi[1] - lo[1]);
+    var bits = bitcast<u32>(f32(ext));
+    if Real(bitcast<f32>(bits)) < ext {
+        bits = bits + 1u;
+    }
+    atomicMax(&cell_bits[0], bits);
     let n = ncand[e];
     ncand_old[e] = n;
     for (var k = 0u; k < n; k = k + 1u) {

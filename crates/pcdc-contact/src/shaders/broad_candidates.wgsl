@@ -1,4 +1,4 @@
-// Broad phase, step 6b (one invocation per element, only when rebuilding): the sorted
+// Broad phase, step 5b (one invocation per element, only when rebuilding): the sorted
 // list of elements whose boxes overlap this one's and that share no node with it (the
 // same test as the CPU's `grid_candidates`), from the buckets of the 3 x 3 cells around
 // its box centre; then the pair history of partners that were already candidates.
@@ -18,7 +18,7 @@ fn overlaps(e: u32, f: u32) -> bool {
 }
 
 fn kernel(e: u32) {
-    if atomicLoad(&flag[0]) == 0u {
+    if atomicLoad(&flag[p_step() & 1u]) == 0u {
         return;
     }
     let cell = grid[0];

@@ -1,7 +1,7 @@
-// Broad phase, step 7 (one invocation per node, only when rebuilding): the positions of
+// Broad phase, step 6 (one invocation per node, only when rebuilding): the positions of
 // this build, against which later steps measure the motion.
 fn kernel(n: u32) {
-    if atomicLoad(&flag[0]) == 0u {
+    if atomicLoad(&flag[p_step() & 1u]) == 0u {
         return;
     }
     for (var k = 0u; k < D; k = k + 1u) {
