@@ -92,9 +92,9 @@ pub trait ContactModel: Send + Sync + Debug {
 ///
 /// with `struct ContactStress { normal: Real, shear: Real }`, `ContactState` an
 /// `array<Real, NSTATE>` of the pair history ([`ContactModel::n_state`], at least one
-/// entry), and the parameters read with `param(p, k)` (k-th entry of `params`). Keep to
-/// + − × ÷, sqrt, abs, min, max (drivers may lack f64 `exp`/`pow`); to match the CPU to
-/// rounding, repeat the CPU arithmetic in the same order.
+/// entry), and the parameters read with `param(p, k)` (k-th entry of `params`). Keep
+/// to + − × ÷, sqrt, abs, min, max (drivers may lack f64 `exp`/`pow`); to match the CPU
+/// to rounding, repeat the CPU arithmetic in the same order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WgslContactModel {
     /// Identifies the code: laws with equal keys must have equal bodies.

@@ -82,6 +82,10 @@ struct Ids {
     state: FieldId,
 }
 
+/// Material assignments resolved on a mesh: the model index of every element and the
+/// models in assignment order.
+type Resolved = (Vec<u16>, Vec<Arc<dyn ConstitutiveModel>>);
+
 impl Mechanics {
     /// Element mechanics with no material yet.
     pub fn new() -> Self {
@@ -112,7 +116,7 @@ impl Mechanics {
     fn resolve<D: Dim>(
         &self,
         mesh: &Mesh<D>,
-    ) -> Result<(Vec<u16>, Vec<Arc<dyn ConstitutiveModel>>), MechError> {
+    ) -> Result<Resolved, MechError> {
         let ne = mesh.n_elements();
         if self.assignments.is_empty() {
             return Err(MechError::param(
