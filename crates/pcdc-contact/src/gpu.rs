@@ -39,7 +39,10 @@ use pcdc_mesh::Dim;
 use crate::model::ContactModel;
 
 const COMMON: &str = include_str!("shaders/broad_common.wgsl");
-const POTENTIAL: &str = include_str!("shaders/potential2d.wgsl");
+const CELLS: &str = include_str!("shaders/broad_cells.wgsl");
+
+/// Bonded neighbours of one element: (neighbour, face), sorted by neighbour.
+pub(crate) type BondList = Vec<(u32, u32)>;
 
 /// What the contact physics hands to the GPU setup.
 pub(crate) struct GpuContactInput<'a> {
@@ -49,7 +52,7 @@ pub(crate) struct GpuContactInput<'a> {
     pub model: &'a dyn ContactModel,
     /// Bonded neighbours per element (neighbour, face), sorted, and the broken-face
     /// field name.
-    pub bonds: Option<(&'a [Vec<(u32, u32)>], &'a str)>,
+    pub bonds: Option<(&'a [BondList], &'a str)>,
     /// Candidate capacity per element, if set by the user.
     pub capacity: Option<usize>,
     /// Name of the reference-position field.
@@ -61,12 +64,6 @@ pub(crate) fn setup<D: Dim>(
     input: GpuContactInput<'_>,
     setup: &mut GpuSetup<'_, D>,
 ) -> Result<(), ComputeError> {
-    if D::D != 2 {
-        return Err(ComputeError::NoGpuKernel {
-            physics: "contact".into(),
-            reason: "3D contact has no GPU kernel yet".into(),
-        });
-    }
     let model = input.model;
     let wgsl = model.wgsl().ok_or_else(|| ComputeError::NoGpuKernel {
         physics: "contact".into(),
@@ -89,21 +86,32 @@ pub(crate) fn setup<D: Dim>(
         None => {
             let margin = 0.5 * input.skin;
             let x = mesh.coords();
-            let boxes: Vec<[f64; 4]> = mesh
+            let (d, npe) = (D::D, D::NODES_PER_ELEM);
+            // Boxes [lows, highs] of the initial elements, inflated by half the skin.
+            let boxes: Vec<([f64; 3], [f64; 3])> = mesh
                 .elements()
-                .chunks_exact(3)
+                .chunks_exact(npe)
                 .map(|c| {
-                    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+                    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
                     for &n in c {
-                        for k in 0..2 {
-                            lo[k] = lo[k].min(x[2 * n as usize + k] - margin);
-                            hi[k] = hi[k].max(x[2 * n as usize + k] + margin);
+                        for k in 0..d {
+                            lo[k] = lo[k].min(x[d * n as usize + k] - margin);
+                            hi[k] = hi[k].max(x[d * n as usize + k] + margin);
                         }
                     }
-                    [lo[0], lo[1], hi[0], hi[1]]
+                    (lo, hi)
                 })
                 .collect();
-            let lists = crate::grid_candidates(&boxes, mesh.elements());
+            let lists = if d == 3 {
+                let b: Vec<[f64; 6]> = boxes
+                    .iter()
+                    .map(|(l, h)| [l[0], l[1], l[2], h[0], h[1], h[2]])
+                    .collect();
+                crate::grid_candidates_3d(&b, mesh.elements())
+            } else {
+                let b: Vec<[f64; 4]> = boxes.iter().map(|(l, h)| [l[0], l[1], h[0], h[1]]).collect();
+                crate::grid_candidates(&b, mesh.elements())
+            };
             (2 * lists.iter().map(Vec::len).max().unwrap_or(0)).max(48)
         }
     };
@@ -120,7 +128,7 @@ pub(crate) fn setup<D: Dim>(
     let conn = setup.upload("connectivity", GpuData::U32(mesh.elements().to_vec()));
     let flag = setup.atomics("rebuild flags", 2);
     let cell_bits = setup.atomics("largest box extent", 1);
-    let boxes = setup.upload("boxes", GpuData::Real(vec![0.0; 4 * ne]));
+    let boxes = setup.upload("boxes", GpuData::Real(vec![0.0; 2 * D::D * ne]));
     let grid = setup.upload("cell size", GpuData::Real(vec![0.0; 1]));
     let keys = setup.upload("bucket keys", GpuData::U32(vec![0; ne]));
     let count = setup.atomics("bucket counts", nbuckets);
@@ -172,8 +180,28 @@ pub(crate) fn setup<D: Dim>(
         Precision::F32 => 1e-30,
     };
     let half = 0.5 * input.skin;
+    // The forces kernel: the law's pieces, the pair potential and the element loop of
+    // the dimension.
+    let (potential, forces) = if D::D == 3 {
+        (
+            include_str!("shaders/potential3d.wgsl"),
+            include_str!("shaders/contact_forces_3d.wgsl"),
+        )
+    } else {
+        (
+            include_str!("shaders/potential2d.wgsl"),
+            include_str!("shaders/contact_forces.wgsl"),
+        )
+    };
+    let forces_source = format!(
+        "alias ContactState = array<Real, NSTATE>;\nstruct ContactStress {{\n    normal: Real,\n    shear: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return model_data[p + k]; }}\nfn pair_penalty(c: u32, t: u32, p: u32) -> Real {{\n{}\n}}\n{potential}{}{forces}",
+        wgsl.pair_penalty.as_deref().unwrap_or("return PENALTY;"),
+        splice.source,
+    );
     let common = |k: Kernel| {
         k.const_u32("D", D::D as u32)
+            .const_u32("NPE", D::NODES_PER_ELEM as u32)
+            .const_u32("NCELLS", if D::D == 3 { 27 } else { 9 })
             .const_u32("CAP", capacity as u32)
             .const_u32("NSTATE", ns as u32)
             .const_u32("NE", ne as u32)
@@ -187,6 +215,8 @@ pub(crate) fn setup<D: Dim>(
         ))
         .bind("flag", flag, Access::ReadWrite)
     };
+    // Kernels that locate box centres on the grid (they bind `boxes`).
+    let cells = |label: &str, body: &str, n: usize| broad(label, &format!("{CELLS}{body}"), n);
     let kernels = [
         broad("moved", include_str!("shaders/broad_moved.wgsl"), nn)
             .const_real("LIMIT2", half * half)
@@ -206,7 +236,7 @@ pub(crate) fn setup<D: Dim>(
             .bind("cand_old", cand_old, Access::ReadWrite)
             .bind("ncand_old", ncand_old, Access::ReadWrite)
             .bind("hist_old", hist_old, Access::ReadWrite),
-        broad("count", include_str!("shaders/broad_count.wgsl"), ne)
+        cells("count", include_str!("shaders/broad_count.wgsl"), ne)
             .const_real("REAL_TINY", tiny)
             .bind("boxes", boxes, Access::Read)
             .bind("cell_bits", cell_bits, Access::ReadWrite)
@@ -224,7 +254,7 @@ pub(crate) fn setup<D: Dim>(
             .bind("bucket_fill", fill, Access::ReadWrite)
             .bind("bucket_start", start, Access::Read)
             .bind("bucket_items", items, Access::ReadWrite),
-        broad(
+        cells(
             "candidates",
             include_str!("shaders/broad_candidates.wgsl"),
             ne,
@@ -246,22 +276,11 @@ pub(crate) fn setup<D: Dim>(
             .bind("coords", setup.coords(), Access::Read)
             .bind("disp", setup.displacement(), Access::Read)
             .bind("reference", reference, Access::ReadWrite),
-        common(Kernel::new(
-            "contact forces",
-            format!(
-                "alias ContactState = array<Real, NSTATE>;\nstruct ContactStress {{\n    normal: Real,\n    shear: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return model_data[p + k]; }}\nfn pair_penalty(c: u32, t: u32, p: u32) -> Real {{\n{}\n}}\n{POTENTIAL}{}{}",
-                wgsl.pair_penalty.as_deref().unwrap_or("return PENALTY;"),
-                splice.source,
-                include_str!("shaders/contact_forces.wgsl")
-            ),
-            ne,
-        ))
+        common(Kernel::new("contact forces", forces_source, ne))
         .const_u32("SLOT_FIRST", setup.slot_first())
         .const_u32("MODEL_KIND", splice.kinds[0])
         .const_u32("MODEL_AT", 0)
         .const_real("PENALTY", model.normal_penalty())
-        .const_real("GAUSS_0", 0.5 - 0.5 / 3f64.sqrt())
-        .const_real("GAUSS_1", 0.5 + 0.5 / 3f64.sqrt())
         .bind("coords", setup.coords(), Access::Read)
         .bind("disp", setup.displacement(), Access::Read)
         .bind("vel", setup.velocity(), Access::Read)
@@ -276,6 +295,13 @@ pub(crate) fn setup<D: Dim>(
         .bind("slots", setup.slots(), Access::ReadWrite),
     ];
     for k in kernels {
+        let k = if D::D == 2 && k.label == "contact forces" {
+            // The Gauss points of the 2D edge integrals.
+            k.const_real("GAUSS_0", 0.5 - 0.5 / 3f64.sqrt())
+                .const_real("GAUSS_1", 0.5 + 0.5 / 3f64.sqrt())
+        } else {
+            k
+        };
         setup.kernel(Phase::Forces, k)?;
     }
     Ok(())
