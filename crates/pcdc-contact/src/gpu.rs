@@ -109,7 +109,10 @@ pub(crate) fn setup<D: Dim>(
                     .collect();
                 crate::grid_candidates_3d(&b, mesh.elements())
             } else {
-                let b: Vec<[f64; 4]> = boxes.iter().map(|(l, h)| [l[0], l[1], h[0], h[1]]).collect();
+                let b: Vec<[f64; 4]> = boxes
+                    .iter()
+                    .map(|(l, h)| [l[0], l[1], h[0], h[1]])
+                    .collect();
                 crate::grid_candidates(&b, mesh.elements())
             };
             (2 * lists.iter().map(Vec::len).max().unwrap_or(0)).max(48)
@@ -215,6 +218,16 @@ pub(crate) fn setup<D: Dim>(
         ))
         .bind("flag", flag, Access::ReadWrite)
     };
+    // The Gauss points of the 2D edge integrals (the 3D face integrals use edge
+    // midpoints).
+    let gauss = |k: Kernel| {
+        if D::D == 2 {
+            k.const_real("GAUSS_0", 0.5 - 0.5 / 3f64.sqrt())
+                .const_real("GAUSS_1", 0.5 + 0.5 / 3f64.sqrt())
+        } else {
+            k
+        }
+    };
     // Kernels that locate box centres on the grid (they bind `boxes`).
     let cells = |label: &str, body: &str, n: usize| broad(label, &format!("{CELLS}{body}"), n);
     let kernels = [
@@ -272,15 +285,21 @@ pub(crate) fn setup<D: Dim>(
         .bind("ncand_old", ncand_old, Access::Read)
         .bind("hist_old", hist_old, Access::Read)
         .bind("status", setup.status(), Access::ReadWrite),
-        broad("reference", include_str!("shaders/broad_reference.wgsl"), nn)
-            .bind("coords", setup.coords(), Access::Read)
-            .bind("disp", setup.displacement(), Access::Read)
-            .bind("reference", reference, Access::ReadWrite),
-        common(Kernel::new("contact forces", forces_source, ne))
-        .const_u32("SLOT_FIRST", setup.slot_first())
-        .const_u32("MODEL_KIND", splice.kinds[0])
-        .const_u32("MODEL_AT", 0)
-        .const_real("PENALTY", model.normal_penalty())
+        broad(
+            "reference",
+            include_str!("shaders/broad_reference.wgsl"),
+            nn,
+        )
+        .bind("coords", setup.coords(), Access::Read)
+        .bind("disp", setup.displacement(), Access::Read)
+        .bind("reference", reference, Access::ReadWrite),
+        gauss(
+            common(Kernel::new("contact forces", forces_source, ne))
+                .const_u32("SLOT_FIRST", setup.slot_first())
+                .const_u32("MODEL_KIND", splice.kinds[0])
+                .const_u32("MODEL_AT", 0)
+                .const_real("PENALTY", model.normal_penalty()),
+        )
         .bind("coords", setup.coords(), Access::Read)
         .bind("disp", setup.displacement(), Access::Read)
         .bind("vel", setup.velocity(), Access::Read)
@@ -295,13 +314,6 @@ pub(crate) fn setup<D: Dim>(
         .bind("slots", setup.slots(), Access::ReadWrite),
     ];
     for k in kernels {
-        let k = if D::D == 2 && k.label == "contact forces" {
-            // The Gauss points of the 2D edge integrals.
-            k.const_real("GAUSS_0", 0.5 - 0.5 / 3f64.sqrt())
-                .const_real("GAUSS_1", 0.5 + 0.5 / 3f64.sqrt())
-        } else {
-            k
-        };
         setup.kernel(Phase::Forces, k)?;
     }
     Ok(())
@@ -312,11 +324,17 @@ mod tests {
     use crate::{Contact, ContactModel, ContactStress};
     use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
     use pcdc_compute::{ComputeError, CpuBackend, Physics, Precision};
-    use pcdc_mesh::{builders, Dim2, Mesh};
+    use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh};
 
     fn two_blocks() -> Mesh<Dim2> {
         let a = builders::rectangle(0.0, 0.0, 0.1, 0.1, 0.02).unwrap();
         let b = builders::rectangle(0.102, 0.0, 0.1, 0.1, 0.02).unwrap();
+        builders::union(&[&a, &b]).unwrap().0
+    }
+
+    fn two_cubes() -> Mesh<Dim3> {
+        let a = builders::cuboid([0.0; 3], [0.05; 3], 0.025).unwrap();
+        let b = builders::cuboid([0.051, 0.01, 0.005], [0.05; 3], 0.025).unwrap();
         builders::union(&[&a, &b]).unwrap().0
     }
 
@@ -325,27 +343,52 @@ mod tests {
         offline_kernel_sources(&two_blocks(), physics, p)
     }
 
-    /// Every contact kernel (with friction and damping) validates with naga, f64 and f32.
+    /// Validates every contact kernel of `contact` on `mesh` with naga; checks that the
+    /// forces kernel is the one of the mesh's dimension.
+    fn validate_all<D: Dim>(mesh: &Mesh<D>, contact: Contact, p: Precision) {
+        let physics: Vec<Box<dyn Physics<D, CpuBackend>>> = vec![Box::new(contact)];
+        let all = offline_kernel_sources(mesh, physics, p).unwrap();
+        let ours: Vec<_> = all
+            .iter()
+            .filter(|(l, _)| l.starts_with("contact"))
+            .collect();
+        assert_eq!(
+            ours.len(),
+            8,
+            "{:?}",
+            all.iter().map(|k| &k.0).collect::<Vec<_>>()
+        );
+        let pair_force = if D::D == 3 {
+            "fn tet_pair_force("
+        } else {
+            "fn triangle_pair_force("
+        };
+        for (label, src) in ours {
+            assert!(
+                src.contains(&format!("const D: u32 = {}u;", D::D)),
+                "{label}"
+            );
+            if label == "contact forces" {
+                assert!(src.contains(pair_force), "{label} of {}D", D::D);
+            }
+            if let Err(e) = validate_wgsl(src) {
+                panic!("{label} ({p:?}, {}D) does not validate:\n{e}", D::D);
+            }
+        }
+    }
+
+    /// Every contact kernel, 2D and 3D, with the built-in law (friction and damping) and
+    /// with surface contact, validates with naga, f64 and f32.
     #[test]
     fn contact_kernels_validate() {
+        let (m2, m3) = (two_blocks(), two_cubes());
         for p in [Precision::F64, Precision::F32] {
-            let contact = Contact::new(1e10).friction(30.0, 1e11).damping(1e6, 2.0);
-            let all = sources(contact, p).unwrap();
-            let ours: Vec<_> = all
-                .iter()
-                .filter(|(l, _)| l.starts_with("contact"))
-                .collect();
-            assert_eq!(
-                ours.len(),
-                8,
-                "{:?}",
-                all.iter().map(|k| &k.0).collect::<Vec<_>>()
-            );
-            for (label, src) in ours {
-                if let Err(e) = validate_wgsl(src) {
-                    panic!("{label} ({p:?}) does not validate:\n{e}");
-                }
-            }
+            let law = || Contact::new(1e10).friction(30.0, 1e11).damping(1e6, 2.0);
+            validate_all(&m2, law(), p);
+            validate_all(&m3, law(), p);
+            let ne = m3.n_elements();
+            let surface = Contact::new(1e10).surface_defaults(vec![25.0; ne], vec![1e10; ne]);
+            validate_all(&m3, surface, p);
         }
     }
 

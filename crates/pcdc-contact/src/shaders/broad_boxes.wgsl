@@ -6,21 +6,26 @@ fn kernel(e: u32) {
     if atomicLoad(&flag[p_step() & 1u]) == 0u {
         return;
     }
-    var lo = array<Real, 2>(REAL_MAX, REAL_MAX);
-    var hi = array<Real, 2>(-REAL_MAX, -REAL_MAX);
-    for (var a = 0u; a < 3u; a = a + 1u) {
-        let n = conn[3u * e + a];
-        for (var k = 0u; k < 2u; k = k + 1u) {
+    var lo = array<Real, D>();
+    var hi = array<Real, D>();
+    for (var k = 0u; k < D; k = k + 1u) {
+        lo[k] = REAL_MAX;
+        hi[k] = -REAL_MAX;
+    }
+    for (var a = 0u; a < NPE; a = a + 1u) {
+        let n = conn[NPE * e + a];
+        for (var k = 0u; k < D; k = k + 1u) {
             let x = coords[n * D + k] + disp[n * D + k];
             lo[k] = min(lo[k], x - MARGIN);
             hi[k] = max(hi[k], x + MARGIN);
         }
     }
-    boxes[4u * e] = lo[0];
-    boxes[4u * e + 1u] = lo[1];
-    boxes[4u * e + 2u] = hi[0];
-    boxes[4u * e + 3u] = hi[1];
-    let ext = max(hi[0] - lo[0], hi[1] - lo[1]);
+    var ext = Real(0.0);
+    for (var k = 0u; k < D; k = k + 1u) {
+        boxes[2u * D * e + k] = lo[k];
+        boxes[2u * D * e + D + k] = hi[k];
+        ext = max(ext, hi[k] - lo[k]);
+    }
     var bits = bitcast<u32>(f32(ext));
     if Real(bitcast<f32>(bits)) < ext {
         bits = bits + 1u;

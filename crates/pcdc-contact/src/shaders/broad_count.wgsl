@@ -6,9 +6,7 @@ fn kernel(e: u32) {
         return;
     }
     let cell = max(Real(bitcast<f32>(atomicLoad(&cell_bits[0]))), REAL_TINY);
-    let cx = cell_of(Real(0.5) * (boxes[4u * e] + boxes[4u * e + 2u]), cell);
-    let cy = cell_of(Real(0.5) * (boxes[4u * e + 1u] + boxes[4u * e + 3u]), cell);
-    let b = bucket(cx, cy);
+    let b = bucket(centre_cell(e, cell));
     keys[e] = b;
     atomicAdd(&bucket_count[b], 1u);
 }
