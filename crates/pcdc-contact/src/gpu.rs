@@ -1,36 +1,55 @@
-//! The contact physics on the GPU (2D): the broad phase as a uniform grid built by
-//! counting sort, and the element-centric pair forces, in WGSL kernels that repeat the
-//! CPU arithmetic in the same order (so f64 results match the CPU to rounding).
+//! The contact physics on the GPU (2D triangles and 3D tetrahedra): the broad phase as a
+//! uniform grid built by counting sort, and the element-centric pair forces, in WGSL
+//! kernels that repeat the CPU arithmetic in the same order (so f64 results match the
+//! CPU to rounding).
 //!
 //! Every step runs, in order (the rebuild kernels return at once when no rebuild is
 //! due; the rebuild flags alternate with the step's parity):
 //!
 //! 1. `moved` (per node): raise the rebuild flag when a node has moved more than half
 //!    the skin since the last build (the CPU's criterion); lower the other step's flag;
-//! 2. `boxes` (per element): inflated boxes, the largest extent (integer atomicMax on the
-//!    bits of an f32 rounded up); keep the old candidate lists and history;
+//! 2. `boxes` (per element): inflated boxes (2 D reals: lows, then highs), the largest
+//!    extent (integer atomicMax on the bits of an f32 rounded up); keep the old
+//!    candidate lists and history;
 //! 3. `count` (per element): bucket of each box centre on the grid of cell size = largest
-//!    extent (cells hashed into a power-of-two table), counted with integer atomics;
+//!    extent (cells (cx, cy, cz) hashed into a power-of-two table; cz = 0 in 2D),
+//!    counted with integer atomics;
 //! 4. `scan` (one invocation): prefix sum of the counts, counters cleared for the next
 //!    build;
 //! 5. `scatter` + `candidates` (per element): bucket items, then each element's sorted
-//!    list of overlapping boxes from the 3 × 3 cells around it, with the pair history of
-//!    partners that were already candidates;
+//!    list of overlapping boxes that share no node with it, from the 3 × 3 (2D) or
+//!    3 × 3 × 3 (3D) cells around it, with the pair history of partners that were already
+//!    candidates: the sets of the CPU's [`crate::grid_candidates`] /
+//!    [`crate::grid_candidates_3d`];
 //! 6. `reference` (per node): positions of this build;
-//! 7. `forces` (per element): Munjiza's potential force and the contact law for every
-//!    candidate, the element's own share written to its slots.
+//! 7. `forces` (per element): Munjiza's potential force (`potential2d.wgsl`,
+//!    `potential3d.wgsl`: [`crate::triangle_pair_force`], [`crate::tet_pair_force`]) and
+//!    the contact law for every candidate (`contact_forces.wgsl`, `contact_forces_3d.wgsl`:
+//!    the CPU's `apply_model` / `apply_model3`; in 3D a pair whose potential force is
+//!    exactly zero skips the law and restarts its history, as on the CPU), the
+//!    element's own share written to its slots.
 //!
-//! Integer atomics count and raise flags; no float atomics. The order inside a bucket
-//! depends on scheduling, but the lists are sorted, so the forces do not.
+//! The broad-phase kernels are one source for both dimensions, specialised by the
+//! constants `D` (dimension) and `NPE` (nodes per element). Integer atomics count and
+//! raise flags; no float atomics. The order inside a bucket depends on scheduling, but
+//! the lists are sorted, so the forces do not.
 //!
 //! Lists have a fixed capacity per element ([`crate::Contact::gpu_capacity`]; default
 //! twice the largest initial list, at least 48): an element that finds more candidates
 //! stops the run with an error naming it. The single-invocation `scan` loops over all
 //! buckets; it runs on rebuild steps only.
 //!
-//! Limitations: 2D; the pair history lives on the device (a snapshot of a GPU run holds
-//! the candidate reference positions but not the friction slip, which restarts at zero
-//! after a restore).
+//! Resources: the forces kernel binds 12 storage buffers plus the step record (the
+//! backend requests the adapter's own limits and reports a kernel that binds more than
+//! the device allows); the 3D forces kernel keeps five clipping polygons of 12 vertices
+//! in private memory (about 3.4 kB per invocation in f64), the `candidates` kernel a
+//! sorted list of `CAP` indices.
+//!
+//! Limitations: the pair history lives on the device (a snapshot of a GPU run holds the
+//! candidate reference positions but not the friction slip, which restarts at zero after
+//! a restore). The 3D pair force is heavy per invocation (face clipping with divergent
+//! branches): on lavapipe (Vulkan on the CPU), with the 2 cores of this project's
+//! machine shared, the 3D parity scene (96 tetrahedra) took 13 s for 456 steps.
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, Precision};
 use pcdc_compute::ComputeError;

@@ -8,17 +8,17 @@
 //! ([`MohrCoulombContact`]: Coulomb friction with a shear penalty, eq. 59-60, and damping
 //! after An and Tannant, eq. 61), and the [`Contact`] physics for `Mesh<Dim2>` and
 //! `Mesh<Dim3>` (sorted-grid broad phase with a skin, deterministic element-centric
-//! assembly, bonded-neighbour exclusion for FDEM regions). 3D contact runs on the CPU
-//! backend; the GPU kernels are 2D.
+//! assembly, bonded-neighbour exclusion for FDEM regions), on the CPU and GPU backends.
 //!
 //! Contact without a contact law uses the elements' own surface friction and penalty
 //! (manual table 1): [`Contact::surface_defaults`] with [`SurfaceContact`].
 //!
-//! On the GPU backend (2D) the broad phase is a uniform grid built by counting sort and
-//! the pair forces run element-centric in WGSL, repeating the CPU arithmetic (f64 results
-//! match the CPU to rounding); laws supply their WGSL through [`ContactModel::wgsl`]
-//! ([`WgslContactModel`]). See the `gpu` module notes in the source for the kernel
-//! sequence and the candidate capacity ([`Contact::gpu_capacity`]).
+//! On the GPU backend (2D and 3D) the broad phase is a uniform grid built by counting
+//! sort and the pair forces run element-centric in WGSL, repeating the CPU arithmetic
+//! (f64 results match the CPU to rounding); laws supply their WGSL through
+//! [`ContactModel::wgsl`] ([`WgslContactModel`]). See the `gpu` module notes in the
+//! source for the kernel sequence, resources and the candidate capacity
+//! ([`Contact::gpu_capacity`]).
 
 #![warn(missing_docs)]
 // Index loops mirror the formulas.
