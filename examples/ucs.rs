@@ -11,8 +11,9 @@
 //! modulus is within 5 % of the input E and UCS / T_s lies in 5–20.
 //!
 //! The same scene from a file: `cargo run --release --example scene -- scenes/ucs.toml`.
-//! Backend: `--backend cpu|gpu`; contact has no GPU kernels yet, so the GPU stops with
-//! a clear error when the simulation is built.
+//! Backend: `--backend cpu|gpu`; on the GPU the scene runs only where every composed
+//! physics has a kernel (otherwise it stops with a clear error when the simulation is
+//! built), and it reads the platen reactions back every step, so it is not fast there.
 
 mod common;
 

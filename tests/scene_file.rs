@@ -67,8 +67,8 @@ fn loading(line: &str) -> String {
     let key = line.split('=').next().unwrap().trim();
     let mut text = String::from("scene = \"ucs\"\n[loading]\n");
     for default in [
-        "platen_velocity = 0.05",
-        "ramp_time = 1e-4",
+        "platen_velocity = 0.1",
+        "ramp_time = 5e-5",
         "stop_fraction = 0.7",
         "max_closure = 0.005",
         "record_every = 100",

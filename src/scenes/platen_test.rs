@@ -287,7 +287,8 @@ pub struct Loading {
     pub platen_velocity: f64,
     /// Time over which the platen speed ramps up linearly from zero (s): no loading shock.
     pub ramp_time: f64,
-    /// After the peak, stop once the load has fallen below this fraction of it, in (0, 1).
+    /// After the peak, stop once the load has fallen below this fraction of it and joints
+    /// have broken, in (0, 1).
     pub stop_fraction: f64,
     /// Stop anyway once the platens have closed by this fraction of the specimen height.
     pub max_closure: f64,
@@ -398,7 +399,9 @@ pub struct Sample {
     /// Load per unit thickness (N/m): mean of the top and bottom platen reactions,
     /// compression positive.
     pub load: f64,
-    /// Kinetic energy of the specimen's nodes (J/m).
+    /// Kinetic energy of the specimen's nodes relative to uniform compression between the
+    /// platens' current velocities, i.e. of the motion a quasi-static test would not
+    /// have (J/m).
     pub kinetic: f64,
     /// Elastic strain energy of all elements (J/m).
     pub strain_energy: f64,
@@ -620,13 +623,25 @@ pub(crate) fn run<B: Backend>(
             (acc, count) = (0.0, 0);
             let closure = mean_y(&sim, &loaded_bottom) - mean_y(&sim, &loaded_top);
             let shortening = mean_y(&sim, &spec_bottom) - mean_y(&sim, &spec_top);
+            // Kinetic energy of the specimen relative to the uniform compression between
+            // the platens' current velocities (the motion a quasi-static test has).
+            let mean_vy = |list: &[u32]| {
+                list.iter()
+                    .map(|&n| sim.state.v[2 * n as usize + 1])
+                    .sum::<f64>()
+                    / list.len().max(1) as f64
+            };
+            let (vb, vt) = (mean_vy(&loaded_bottom), mean_vy(&loaded_top));
             let mass = sim.mass();
             let kinetic = 0.5
                 * spec_nodes
                     .iter()
                     .map(|&n| {
                         let n = n as usize;
-                        mass[n] * (sim.state.v[2 * n].powi(2) + sim.state.v[2 * n + 1].powi(2))
+                        let y = sim.mesh().node(n)[1];
+                        let vq = vb + (vt - vb) * (y - y0) / height;
+                        mass[n]
+                            * (sim.state.v[2 * n].powi(2) + (sim.state.v[2 * n + 1] - vq).powi(2))
                     })
                     .sum::<f64>();
             samples.push(Sample {
@@ -648,9 +663,12 @@ pub(crate) fn run<B: Backend>(
                 load,
                 peak,
             });
+            // Failure: the load has fallen well below its peak and joints have broken
+            // (a dip of the load during the first contact transient is no failure).
             let failed = peak > 0.0
                 && load < s.loading.stop_fraction * peak
-                && samples.len() > peak_index + 1;
+                && samples.len() > peak_index + 1
+                && sim.field(JOINT_DAMAGE)?.iter().any(|&d| d >= 1.0);
             if failed || step >= max_steps {
                 break;
             }
