@@ -123,16 +123,14 @@ impl Mechanics {
                 "material",
                 "none",
                 "assign at least one constitutive model with Mechanics::material",
-            )
-            );
+            ));
         }
         if self.assignments.len() > u16::MAX as usize {
             return Err(MechError::param(
                 "material count",
                 self.assignments.len(),
                 "at most 65535 assignments",
-            )
-            );
+            ));
         }
         let mut material = vec![u16::MAX; ne];
         let mut models = Vec::new();
@@ -143,8 +141,7 @@ impl Mechanics {
                     what: format!("material {} ({})", i, model.name()),
                     range: format!("{range:?}"),
                     entity: "element",
-                }
-                );
+                });
             }
             for e in sel {
                 material[e as usize] = i as u16;
@@ -156,8 +153,7 @@ impl Mechanics {
                 format!("material of element {e}"),
                 "none",
                 "every element needs a constitutive model; add a Mechanics::material covering it",
-            )
-            );
+            ));
         }
         Ok((material, models))
     }
