@@ -44,3 +44,4 @@ pub use pcdc_mesh as mesh;
 pub mod plot;
 pub mod report;
 pub mod scenes;
+pub mod validation;

@@ -110,6 +110,27 @@ fn block_sliding_stops_within_3_percent() {
     }
 }
 
+/// The same scene on the GPU (lavapipe in CI): contact with friction on the device.
+/// Reduced to v0 = 0.5 m/s and 5 cm triangles: lavapipe costs about 2.4 ms a step here.
+#[test]
+fn block_sliding_on_the_gpu_within_3_percent() {
+    use pcdc::scenes::block_sliding;
+    let Some(gpu) = pcdc::compute::gpu::gpu_test_backend(Some(pcdc::compute::Precision::F64))
+    else {
+        return;
+    };
+    let o = block_sliding::run_sized(&gpu, 0.5, 0.05).unwrap();
+    eprintln!(
+        "block sliding on the GPU, v0 0.5: {:.5} m vs {:.5} m ({:.3} %), {} steps, {:.1} s",
+        o.distance,
+        o.expected,
+        100.0 * o.error,
+        o.steps,
+        o.wall_s
+    );
+    assert!(o.error <= block_sliding::TOL, "error {}", o.error);
+}
+
 #[test]
 fn result_line_names_the_backend_it_ran_on() {
     let line = pcdc::report::ResultLine::new(&cpu(), "case", "metric", 0.01, 0.03, 10, 5, 0.5);

@@ -56,11 +56,20 @@ fn block_on_base(size: f64, length: f64) -> Result<Mesh<Dim2>, SceneError> {
     Ok(builders::union(&[&base, &block])?.0)
 }
 
-/// Runs one initial speed `v0` (m/s) on `backend` (cloned into the simulation).
+/// Mesh sizes of the speed-against-error report (m); the example uses 0.025.
+pub const SIZES: [f64; 3] = [0.05, 0.025, 0.0125];
+
+/// Runs one initial speed `v0` (m/s) on `backend` (cloned into the simulation), with
+/// 2.5 cm triangles.
 pub fn run<B: Backend>(backend: &B, v0: f64) -> Result<Outcome, SceneError> {
+    run_sized(backend, v0, 0.025)
+}
+
+/// Runs one initial speed `v0` (m/s) with triangles of size `size` (m).
+pub fn run_sized<B: Backend>(backend: &B, v0: f64, size: f64) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let d_exact = expected(v0);
-    let mesh = block_on_base(0.025, 0.3 + 1.2 * d_exact)?;
+    let mesh = block_on_base(size, 0.3 + 1.2 * d_exact)?;
     let rock = LinearElastic::new(E, 0.25, 1000.0)?.with_damping(1.0)?;
     let mut sim = Simulation::builder(mesh, backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))

@@ -1,0 +1,169 @@
+//! The speed-against-error report: every validation scene at three mesh sizes on every
+//! backend and precision available; writes `docs/validation.md` and
+//! `docs/validation-error-vs-time.png` (see `pcdc::validation`).
+//!
+//! ```sh
+//! cargo run --release --example validation_report
+//! ```
+//!
+//! Options:
+//! - `--cases kirsch,wave_speed,...` only these scenes (default: all);
+//! - `--backends cpu,gpu-f64,gpu-f32` only these backends (default: all available);
+//! - `--resume` keep the rows already in `out/validation/rows.csv` and run only the
+//!   missing ones (without it the cache starts afresh).
+//!
+//! The table and the plot are written from every cached row, so a report can be built
+//! one case or backend at a time. Each row is printed as it finishes.
+
+use std::io::Write;
+
+use pcdc::validation::{self, Row};
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn list(args: &[String], flag: &str) -> Option<Vec<String>> {
+    let i = args.iter().position(|a| a == flag)?;
+    Some(
+        args.get(i + 1)
+            .map(|v| v.split(',').map(str::to_string).collect())
+            .unwrap_or_default(),
+    )
+}
+
+fn machine(backends: &[validation::AnyBackend]) -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut s = format!("{cpu}, {threads} threads");
+    for b in backends {
+        if let validation::AnyBackend::Gpu(g) = b {
+            s.push_str(&format!("; {}: {}", b.label(), g.adapter_name()));
+        }
+    }
+    s
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    for a in &args {
+        if a.starts_with("--") && !["--cases", "--backends", "--resume"].contains(&a.as_str()) {
+            return Err(format!("unknown option '{a}' (use --cases, --backends, --resume)").into());
+        }
+    }
+    let cases: Vec<String> = match list(&args, "--cases") {
+        Some(c) => c,
+        None => validation::CASES.iter().map(|c| c.to_string()).collect(),
+    };
+    for c in &cases {
+        if !validation::CASES.contains(&c.as_str()) {
+            return Err(format!(
+                "unknown case '{c}' (cases: {})",
+                validation::CASES.join(", ")
+            )
+            .into());
+        }
+    }
+    let mut backends = validation::available_backends();
+    if let Some(only) = list(&args, "--backends") {
+        for o in &only {
+            if !["cpu", "gpu-f64", "gpu-f32"].contains(&o.as_str()) {
+                return Err(format!("unknown backend '{o}' (cpu, gpu-f64, gpu-f32)").into());
+            }
+        }
+        backends.retain(|b| only.contains(&b.label()));
+    }
+    let dir = pcdc::report::out_dir("validation")?;
+    let cache = dir.join("rows.csv");
+    let mut rows: Vec<Row> = Vec::new();
+    if args.iter().any(|a| a == "--resume") {
+        if let Ok(text) = std::fs::read_to_string(&cache) {
+            rows = text.lines().filter_map(Row::from_csv).collect();
+        }
+    } else {
+        std::fs::write(&cache, "")?;
+    }
+    println!("{} cached rows; backends: {}", rows.len(), {
+        let l: Vec<String> = backends.iter().map(|b| b.label()).collect();
+        l.join(", ")
+    });
+    for b in &backends {
+        for case in &cases {
+            for job in validation::jobs(case, b.is_gpu()) {
+                let probe = Row {
+                    case: job.case.into(),
+                    variant: job.variant.into(),
+                    size: job.size,
+                    elements: 0,
+                    backend: if b.is_gpu() { "gpu" } else { "cpu" }.into(),
+                    precision: b.label().trim_start_matches("gpu-").replace("cpu", "f64"),
+                    error: 0.0,
+                    tol: String::new(),
+                    pass: false,
+                    steps: 0,
+                    wall_s: 0.0,
+                };
+                if rows.iter().any(|r| r.key() == probe.key()) {
+                    continue;
+                }
+                print!(
+                    "{:<16} {:<11} size {:<8} {:<8} ... ",
+                    job.case,
+                    job.variant,
+                    job.size,
+                    b.label()
+                );
+                std::io::stdout().flush()?;
+                match b.run(&job) {
+                    Ok(row) => {
+                        println!(
+                            "{} elements, error {:.3e}, {} steps, {:.1} s{}",
+                            row.elements,
+                            row.error,
+                            row.steps,
+                            row.wall_s,
+                            if row.pass { "" } else { "  ** FAIL **" }
+                        );
+                        let mut f = std::fs::OpenOptions::new().append(true).open(&cache)?;
+                        writeln!(f, "{}", row.to_csv())?;
+                        rows.push(row);
+                    }
+                    Err(e) => println!("not run: {e}"),
+                }
+            }
+        }
+    }
+    std::fs::create_dir_all("docs")?;
+    std::fs::write(
+        "docs/validation.md",
+        validation::markdown(&rows, &machine(&backends)),
+    )?;
+    validation::plot(
+        &rows,
+        std::path::Path::new("docs/validation-error-vs-time.png"),
+    )?;
+    println!(
+        "wrote docs/validation.md and docs/validation-error-vs-time.png ({} rows)",
+        rows.len()
+    );
+    let failed = rows.iter().filter(|r| !r.pass).count();
+    println!(
+        "RESULT case=validation_report metric=failed_rows value={failed} tol=0 pass={} elements={} steps={} wall_s={:.1} backend=all precision=all",
+        failed == 0,
+        rows.iter().map(|r| r.elements).sum::<usize>(),
+        rows.iter().map(|r| r.steps).sum::<u64>(),
+        rows.iter().map(|r| r.wall_s).sum::<f64>()
+    );
+    Ok(())
+}

@@ -1,0 +1,485 @@
+//! The speed-against-error report: every validation scene at three mesh sizes on every
+//! backend and precision available, collected into `docs/validation.md` (one table) and
+//! `docs/validation-error-vs-time.png` (error against wall time).
+//!
+//! Run by `cargo run --release --example validation_report` (see that example for the
+//! options). Each finished row is appended to `out/validation/rows.csv`, so a long report
+//! can be resumed (`--resume`) or extended one case or backend at a time; the Markdown
+//! table and the plot are always written from every row in that file.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use pcdc_compute::{Backend, CpuBackend, Precision, WgpuBackend};
+
+use crate::plot::Plot;
+use crate::report::SceneError;
+use crate::scenes::{block_sliding, direct_tension, kirsch, vibration_energy, wave_speed};
+
+/// One measured row of the report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// Scene name (as in the RESULT lines).
+    pub case: String,
+    /// Variant within the scene (solver, dimension, speed, ...).
+    pub variant: String,
+    /// Mesh size (m).
+    pub size: f64,
+    /// Elements.
+    pub elements: usize,
+    /// `cpu` or `gpu`.
+    pub backend: String,
+    /// `f64` or `f32`.
+    pub precision: String,
+    /// The scene's error measure (relative, signed where the tolerance is one-sided).
+    pub error: f64,
+    /// The tolerance, as printed (e.g. `3 %`, `−5 % / +10 %`).
+    pub tol: String,
+    /// Within tolerance.
+    pub pass: bool,
+    /// Explicit steps (or solver iterations).
+    pub steps: u64,
+    /// Wall time (s), build included.
+    pub wall_s: f64,
+}
+
+impl Row {
+    /// Element-steps per second (elements × steps / wall time).
+    pub fn element_steps_per_s(&self) -> f64 {
+        if self.wall_s > 0.0 {
+            self.elements as f64 * self.steps as f64 / self.wall_s
+        } else {
+            0.0
+        }
+    }
+
+    /// The row as one CSV line (no commas inside fields).
+    pub fn to_csv(&self) -> String {
+        format!(
+            "{},{},{:e},{},{},{},{:e},{},{},{},{:e}",
+            self.case,
+            self.variant,
+            self.size,
+            self.elements,
+            self.backend,
+            self.precision,
+            self.error,
+            self.tol,
+            self.pass,
+            self.steps,
+            self.wall_s
+        )
+    }
+
+    /// Parses a line written by [`Row::to_csv`].
+    pub fn from_csv(line: &str) -> Option<Row> {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() != 11 {
+            return None;
+        }
+        Some(Row {
+            case: f[0].into(),
+            variant: f[1].into(),
+            size: f[2].parse().ok()?,
+            elements: f[3].parse().ok()?,
+            backend: f[4].into(),
+            precision: f[5].into(),
+            error: f[6].parse().ok()?,
+            tol: f[7].into(),
+            pass: f[8].parse().ok()?,
+            steps: f[9].parse().ok()?,
+            wall_s: f[10].parse().ok()?,
+        })
+    }
+
+    /// Identifies the measurement (everything but the results).
+    pub fn key(&self) -> String {
+        format!(
+            "{}|{}|{:e}|{}|{}",
+            self.case, self.variant, self.size, self.backend, self.precision
+        )
+    }
+}
+
+/// The scenes of the report.
+pub const CASES: &[&str] = &[
+    "kirsch",
+    "wave_speed",
+    "vibration_energy",
+    "block_sliding",
+    "direct_tension",
+];
+
+/// A measurement the report will make: case, variant, mesh size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Job {
+    /// Scene.
+    pub case: &'static str,
+    /// Variant.
+    pub variant: &'static str,
+    /// Mesh size (m).
+    pub size: f64,
+}
+
+/// The jobs of `case` on a backend of kind `gpu` (the direct Kirsch solve is a host
+/// solve and runs on the CPU only).
+pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
+    let j = |case, variant, size| Job {
+        case,
+        variant,
+        size,
+    };
+    let kirsch_full = kirsch::Params::full().size_at_hole;
+    let wave = wave_speed::Params::full().size;
+    let vib = vibration_energy::Params::full().size;
+    let dt = direct_tension::Params::full().size;
+    let mut out = Vec::new();
+    match case {
+        "kirsch" => {
+            for size in [0.1, 0.05, kirsch_full] {
+                if !gpu {
+                    out.push(j("kirsch", "direct", size));
+                }
+                out.push(j("kirsch", "relaxation", size));
+            }
+        }
+        "wave_speed" | "vibration_energy" => {
+            let (name, s) = if case == "wave_speed" {
+                ("wave_speed", wave)
+            } else {
+                ("vibration_energy", vib)
+            };
+            for size in [4.0 * s, 2.0 * s, s] {
+                out.push(j(name, "2d", size));
+                out.push(j(name, "3d", size));
+            }
+        }
+        "block_sliding" => {
+            for size in block_sliding::SIZES {
+                out.push(j("block_sliding", "v0 = 2 m/s", size));
+            }
+        }
+        "direct_tension" => {
+            for size in [0.005, 0.003, dt] {
+                out.push(j("direct_tension", "peak vs Ts", size));
+            }
+        }
+        _ => {}
+    }
+    out
+}
+
+fn pct(x: f64) -> String {
+    format!("{} %", x * 100.0)
+}
+
+/// Runs one job on `backend`.
+pub fn run_job<B: Backend>(backend: &B, job: &Job) -> Result<Row, SceneError> {
+    let start = Instant::now();
+    let row = |elements, error: f64, tol: String, pass, steps| Row {
+        case: job.case.into(),
+        variant: job.variant.into(),
+        size: job.size,
+        elements,
+        backend: backend.kind().name().into(),
+        precision: backend.precision().into(),
+        error,
+        tol,
+        pass,
+        steps,
+        wall_s: start.elapsed().as_secs_f64(),
+    };
+    Ok(match job.case {
+        "kirsch" => {
+            let solver = if job.variant == "direct" {
+                kirsch::Solver::Direct
+            } else {
+                kirsch::Solver::Relaxation
+            };
+            let p = kirsch::Params {
+                size_at_hole: job.size,
+                ..kirsch::Params::full()
+            };
+            let o = kirsch::run(backend, &p, solver)?;
+            row(
+                o.elements,
+                o.error,
+                pct(kirsch::TOL),
+                o.error <= kirsch::TOL,
+                o.steps,
+            )
+        }
+        "wave_speed" => {
+            let p = wave_speed::Params { size: job.size };
+            let o = if job.variant == "2d" {
+                wave_speed::run_2d(backend, &p)?
+            } else {
+                wave_speed::run_3d(backend, &p)?
+            };
+            row(
+                o.elements,
+                o.error,
+                pct(wave_speed::TOL),
+                o.error <= wave_speed::TOL,
+                o.steps,
+            )
+        }
+        "vibration_energy" => {
+            let p = vibration_energy::Params {
+                size: job.size,
+                ..vibration_energy::Params::full()
+            };
+            let o = if job.variant == "2d" {
+                vibration_energy::run_2d(backend, &p)?
+            } else {
+                vibration_energy::run_3d(backend, &p)?
+            };
+            row(
+                o.elements,
+                o.drift,
+                pct(vibration_energy::TOL),
+                o.drift <= vibration_energy::TOL,
+                o.steps,
+            )
+        }
+        "block_sliding" => {
+            let o = block_sliding::run_sized(backend, 2.0, job.size)?;
+            row(
+                o.elements,
+                o.error,
+                pct(block_sliding::TOL),
+                o.error <= block_sliding::TOL,
+                o.steps,
+            )
+        }
+        "direct_tension" => {
+            let p = direct_tension::Params {
+                size: job.size,
+                vtu_dir: None,
+            };
+            let o = direct_tension::run(backend, &p)?;
+            row(
+                o.elements,
+                o.deviation,
+                format!(
+                    "−{} % / +{} %",
+                    direct_tension::TOL_LOW * 100.0,
+                    direct_tension::TOL_HIGH * 100.0
+                ),
+                o.band_metric() <= 1.0,
+                o.steps,
+            )
+        }
+        other => {
+            return Err(SceneError::Measurement(format!(
+                "unknown validation case '{other}'"
+            )))
+        }
+    })
+}
+
+/// A backend the report runs on.
+pub enum AnyBackend {
+    /// The CPU (all threads).
+    Cpu(CpuBackend),
+    /// The GPU at one precision.
+    Gpu(WgpuBackend),
+}
+
+impl AnyBackend {
+    /// `cpu`, `gpu-f64` or `gpu-f32`.
+    pub fn label(&self) -> String {
+        match self {
+            AnyBackend::Cpu(_) => "cpu".into(),
+            AnyBackend::Gpu(b) => format!("gpu-{}", b.precision()),
+        }
+    }
+
+    /// Runs `job` on this backend.
+    pub fn run(&self, job: &Job) -> Result<Row, SceneError> {
+        match self {
+            AnyBackend::Cpu(b) => run_job(b, job),
+            AnyBackend::Gpu(b) => run_job(b, job),
+        }
+    }
+
+    /// Whether this is a GPU backend.
+    pub fn is_gpu(&self) -> bool {
+        matches!(self, AnyBackend::Gpu(_))
+    }
+}
+
+/// Every backend available here: the CPU, and the GPU in f64 (where the adapter has it)
+/// and f32. Says on stderr why a GPU backend is missing.
+pub fn available_backends() -> Vec<AnyBackend> {
+    let mut out = Vec::new();
+    match CpuBackend::new(0) {
+        Ok(b) => out.push(AnyBackend::Cpu(b)),
+        Err(e) => eprintln!("no CPU backend: {e}"),
+    }
+    for p in [Precision::F64, Precision::F32] {
+        match WgpuBackend::new(Some(p)) {
+            Ok(b) => out.push(AnyBackend::Gpu(b)),
+            Err(e) => eprintln!("no GPU backend in {}: {e}", p.name()),
+        }
+    }
+    out
+}
+
+/// The Markdown report: header with the command and the machine, one table of all rows
+/// (sorted by case, variant, backend, size), and the plot.
+pub fn markdown(rows: &[Row], machine: &str) -> String {
+    let mut rows = rows.to_vec();
+    rows.sort_by(|a, b| {
+        (
+            a.case.as_str(),
+            a.variant.as_str(),
+            a.backend.as_str(),
+            b.precision.as_str(),
+        )
+            .cmp(&(
+                b.case.as_str(),
+                b.variant.as_str(),
+                b.backend.as_str(),
+                a.precision.as_str(),
+            ))
+            .then(b.size.total_cmp(&a.size))
+    });
+    let mut s = String::new();
+    s.push_str("# Validation: error against mesh size and time\n\n");
+    s.push_str(
+        "Written by `cargo run --release --example validation_report` (every validation scene \
+         at three mesh sizes, on every backend and precision available; rows are cached in \
+         `out/validation/rows.csv`, see the example's options). Do not edit by hand.\n\n",
+    );
+    let _ = writeln!(s, "Machine: {machine}.\n");
+    s.push_str(
+        "Error: the scene's measure (kirsch: max error / max |σθ|; wave_speed: wave speed; \
+         vibration_energy: energy drift; block_sliding: stopping distance; direct_tension: \
+         peak neck stress against Ts, signed). Wall time includes the build; \
+         element-steps/s = elements × steps / wall time (the direct Kirsch solve counts \
+         its iterations as steps). GPU rows on a software adapter (Mesa's lavapipe) \
+         show that the path works and what it costs there, not GPU speed.\n\n",
+    );
+    s.push_str("![error against wall time](validation-error-vs-time.png)\n\n");
+    s.push_str("| case | variant | mesh size (m) | elements | backend | precision | error | tolerance | pass | steps | wall (s) | element-steps/s |\n");
+    s.push_str(
+        "| --- | --- | ---: | ---: | --- | --- | ---: | ---: | --- | ---: | ---: | ---: |\n",
+    );
+    for r in &rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.3e} |",
+            r.case,
+            r.variant,
+            r.size,
+            r.elements,
+            r.backend,
+            r.precision,
+            format_error(r.error),
+            r.tol,
+            if r.pass { "yes" } else { "**no**" },
+            r.steps,
+            r.wall_s,
+            r.element_steps_per_s()
+        );
+    }
+    s
+}
+
+fn format_error(e: f64) -> String {
+    if e.abs() >= 1e-4 {
+        format!("{:.3} %", 100.0 * e)
+    } else {
+        format!("{e:.2e}")
+    }
+}
+
+/// The plot: |error| against wall time, log-log, one series per case and backend.
+pub fn plot(rows: &[Row], path: &Path) -> Result<(), SceneError> {
+    let mut groups: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
+    for r in rows {
+        let label = format!("{} {} {}-{}", r.case, r.variant, r.backend, r.precision);
+        let (x, y) = (r.wall_s.max(1e-3), r.error.abs().max(1e-12));
+        match groups.iter_mut().find(|g| g.0 == label) {
+            Some(g) => {
+                g.1.push(x);
+                g.2.push(y);
+            }
+            None => groups.push((label, vec![x], vec![y])),
+        }
+    }
+    let mut p = Plot::new(
+        "Validation scenes: error against wall time",
+        "wall time (s)",
+        "|error| (relative)",
+    )
+    .log_x(true)
+    .log_y(true)
+    .size(1400, 900);
+    for (label, x, y) in groups {
+        // Sort by time so the line joins the mesh sizes in order.
+        let mut pts: Vec<(f64, f64)> = x.into_iter().zip(y).collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (x, y) = pts.into_iter().unzip();
+        p = p.line_points(label, x, y);
+    }
+    p.save_png(path)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(case: &str, error: f64) -> Row {
+        Row {
+            case: case.into(),
+            variant: "2d".into(),
+            size: 0.005,
+            elements: 1000,
+            backend: "cpu".into(),
+            precision: "f64".into(),
+            error,
+            tol: "2 %".into(),
+            pass: error <= 0.02,
+            steps: 500,
+            wall_s: 0.25,
+        }
+    }
+
+    #[test]
+    fn rows_round_trip_through_csv() {
+        let r = row("wave_speed", 0.0123456789);
+        assert_eq!(Row::from_csv(&r.to_csv()), Some(r.clone()));
+        assert_eq!(r.element_steps_per_s(), 2e6);
+        assert!(Row::from_csv("a,b,c").is_none());
+    }
+
+    #[test]
+    fn markdown_lists_every_row_and_flags_failures() {
+        let md = markdown(
+            &[row("wave_speed", 0.01), row("kirsch", 0.05)],
+            "test machine",
+        );
+        assert!(md.contains("| wave_speed | 2d | 0.005 | 1000 | cpu | f64 | 1.000 % | 2 % | yes |"));
+        assert!(md.contains("| kirsch | 2d | 0.005 | 1000 | cpu | f64 | 5.000 % | 2 % | **no** |"));
+        // Kirsch sorts first.
+        assert!(md.find("| kirsch").unwrap() < md.find("| wave_speed").unwrap());
+    }
+
+    #[test]
+    fn every_case_has_three_sizes() {
+        for case in CASES {
+            let j = jobs(case, false);
+            let mut sizes: Vec<f64> = j.iter().map(|j| j.size).collect();
+            sizes.sort_by(f64::total_cmp);
+            sizes.dedup();
+            assert_eq!(sizes.len(), 3, "{case}");
+        }
+        assert!(jobs("kirsch", true)
+            .iter()
+            .all(|j| j.variant == "relaxation"));
+    }
+}
