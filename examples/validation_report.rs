@@ -104,7 +104,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                 let probe = Row {
                     case: job.case.into(),
                     variant: job.variant.into(),
-                    size: job.size,
+                    size: job.mesh_size(),
                     elements: 0,
                     backend: if b.is_gpu() { "gpu" } else { "cpu" }.into(),
                     precision: b.label().trim_start_matches("gpu-").replace("cpu", "f64"),
@@ -121,7 +121,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                     "{:<16} {:<11} size {:<8} {:<8} ... ",
                     job.case,
                     job.variant,
-                    job.size,
+                    job.mesh_size(),
                     b.label()
                 );
                 std::io::stdout().flush()?;
