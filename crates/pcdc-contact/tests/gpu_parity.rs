@@ -9,7 +9,8 @@
 //! hard enough that joints break and their faces become contact faces; (3) two
 //! tetrahedral blocks collide obliquely, one spinning about two axes, with friction and
 //! damping, under a small skin so the candidate lists are rebuilt several times while
-//! the blocks touch.
+//! the blocks touch, and again with element-surface contact (per-element friction and
+//! penalty).
 //!
 //! Measured and compared: displacement and velocity (f64: max |Δu| / max |u| ≤ 1e-12).
 //! Fracture amplifies any rounding difference: in the FDEM scene the CPU is also run
@@ -118,17 +119,29 @@ fn fdem<B: Backend>(backend: B, perturb: f64) -> Outcome {
 /// so the candidate lists are rebuilt several times while they touch. `chunk`: run in
 /// two `run()` calls (half the steps, then the rest) when `None`; otherwise in calls of
 /// `chunk` steps, counting the broad-phase builds from the reference-position field
-/// after each call (exact for `chunk` = 1). Returns the outcome, the builds counted and
-/// the mean velocity of the struck block.
-fn impact_3d<B: Backend>(backend: B, chunk: Option<u64>) -> (Outcome, usize, [f64; 3]) {
+/// after each call (exact for `chunk` = 1). `surface`: the law is element-surface
+/// contact (table 1) with friction and penalty varying by element instead. Returns the
+/// outcome, the builds counted and the mean velocity of the struck block.
+fn impact_3d<B: Backend>(
+    backend: B,
+    chunk: Option<u64>,
+    surface: bool,
+) -> (Outcome, usize, [f64; 3]) {
     let a = builders::cuboid([0.0; 3], [0.04; 3], 0.02).unwrap();
     let b = builders::cuboid([0.0401, 0.012, 0.007], [0.04; 3], 0.02).unwrap();
     let (mesh, bodies) = builders::union(&[&a, &b]).unwrap();
+    let ne = mesh.n_elements();
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
-    let contact = Contact::new(10.0 * E)
-        .friction(30.0, 50.0 * E)
-        .damping(2e6, 2.0)
-        .skin(2e-4);
+    let contact = if surface {
+        let friction = (0..ne).map(|e| 15.0 + 5.0 * (e % 4) as f64).collect();
+        let penalty = (0..ne).map(|e| (5.0 + 3.0 * (e % 3) as f64) * E).collect();
+        Contact::new(10.0 * E).surface_defaults(friction, penalty)
+    } else {
+        Contact::new(10.0 * E)
+            .friction(30.0, 50.0 * E)
+            .damping(2e6, 2.0)
+    };
+    let contact = contact.skin(2e-4);
     let mut sim: Simulation<Dim3, B> = Simulation::builder(mesh, backend)
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(contact)
@@ -168,12 +181,13 @@ fn impact_3d<B: Backend>(backend: B, chunk: Option<u64>) -> (Outcome, usize, [f6
     }
     // Mean velocity of the struck (right) block: the impact pushes it along x, friction
     // drags it along y and z.
-    let mut struck = [0.0; 3];
-    for &n in &bodies[1] {
-        for d in 0..3 {
-            struck[d] += sim.state.v[3 * n as usize + d] / bodies[1].len() as f64;
-        }
-    }
+    let struck: [f64; 3] = std::array::from_fn(|d| {
+        let sum: f64 = bodies[1]
+            .iter()
+            .map(|&n| sim.state.v[3 * n as usize + d])
+            .sum();
+        sum / bodies[1].len() as f64
+    });
     let out = Outcome {
         u: sim.state.u.clone(),
         v: sim.state.v.clone(),
@@ -281,9 +295,9 @@ fn tet_blocks_frictional_damped_impact_matches_cpu_f64() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    let (cpu, _, struck) = impact_3d(CpuBackend::new(1).unwrap(), None);
+    let (cpu, _, struck) = impact_3d(CpuBackend::new(1).unwrap(), None, false);
     // The same run step by step on the CPU: the scene does rebuild the lists during it.
-    let (stepped, builds, _) = impact_3d(CpuBackend::new(1).unwrap(), Some(1));
+    let (stepped, builds, _) = impact_3d(CpuBackend::new(1).unwrap(), Some(1), false);
     assert_eq!(stepped.u, cpu.u, "the CPU depends on how the run is split");
     println!("impact 3d: {builds} broad-phase builds, struck block at {struck:.3?} m/s");
     // The blocks did collide, and friction dragged the struck block sideways.
@@ -294,7 +308,7 @@ fn tet_blocks_frictional_damped_impact_matches_cpu_f64() {
         "only {builds} broad-phase builds: raise the speed or lower the skin"
     );
     let reads = gpu.readbacks();
-    let (dev, _, _) = impact_3d(gpu.clone(), None);
+    let (dev, _, _) = impact_3d(gpu.clone(), None, false);
     assert_eq!(gpu.readbacks() - reads, 2);
     compare("impact 3d f64", &cpu, &dev, (1e-12, 1e-11));
 }
@@ -304,8 +318,22 @@ fn tet_blocks_impact_f32_is_close() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F32)) else {
         return;
     };
-    let (cpu, _, _) = impact_3d(CpuBackend::new(1).unwrap(), None);
-    let (dev, _, _) = impact_3d(gpu, None);
+    let (cpu, _, _) = impact_3d(CpuBackend::new(1).unwrap(), None, false);
+    let (dev, _, _) = impact_3d(gpu, None, false);
     // Measured and printed; bounded loosely (single precision, a frictional impact).
     compare("impact 3d f32", &cpu, &dev, (2e-2, 2e-2));
+}
+
+/// Element-surface contact (table 1) in 3D: the per-pair penalty and friction of
+/// `SurfaceContact` go through the same splice on the GPU.
+#[test]
+fn tet_blocks_surface_contact_matches_cpu_f64() {
+    let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
+        return;
+    };
+    let (cpu, _, struck) = impact_3d(CpuBackend::new(1).unwrap(), None, true);
+    println!("surface contact 3d: struck block at {struck:.3?} m/s");
+    assert!(struck[0] > 0.3, "no impact: {struck:?}");
+    let (dev, _, _) = impact_3d(gpu, None, true);
+    compare("surface contact 3d f64", &cpu, &dev, (1e-12, 1e-11));
 }
