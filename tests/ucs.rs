@@ -1,4 +1,4 @@
-//! Reduced-size UCS test (validation scene 8): 4 mm mesh, platens at 0.1 m/s. The
+//! Reduced-size UCS test (validation scene 8): 5 mm mesh, platens at 0.1 m/s. The
 //! modulus from the linear part must equal the closed-form modulus of the jointed
 //! sample within 2 %, UCS / T_s must lie in 5–20, and the peak must be a finite,
 //! positive strength after which the sample softens.

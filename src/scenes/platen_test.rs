@@ -712,7 +712,7 @@ fn broken_joints<B: Backend>(
     let damage = sim.field(JOINT_DAMAGE)?;
     let state = sim.field(JOINT_STATE)?;
     let nj = joints.len();
-    let stride = if nj > 0 { state.len() / nj } else { 0 };
+    let stride = state.len().checked_div(nj).unwrap_or(0);
     let mut count = BrokenCount::default();
     let mut cracks = Vec::new();
     for (j, &d) in damage.iter().enumerate() {

@@ -221,10 +221,10 @@ impl Params {
         Self::default()
     }
 
-    /// Reduced size for tests: 4 mm mesh, no VTU output.
+    /// Reduced size for tests: 5 mm mesh, no VTU output.
     pub fn reduced() -> Self {
         let mut p = Self::default();
-        p.sample.mesh_size = 0.004;
+        p.sample.mesh_size = 0.005;
         p.loading.record_every = 50;
         p.output.frames = 0;
         p
