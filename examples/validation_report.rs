@@ -47,6 +47,15 @@ fn machine(backends: &[validation::AnyBackend]) -> String {
         .unwrap_or_else(|| "unknown CPU".into());
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut s = format!("{cpu}, {threads} threads");
+    // Wall times depend on what else ran: say how loaded the machine was.
+    if let Some(load) = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().nth(1).map(str::to_string))
+    {
+        s.push_str(&format!(
+            " (5-minute load average {load} when the report was written)"
+        ));
+    }
     for b in backends {
         if let validation::AnyBackend::Gpu(g) = b {
             s.push_str(&format!("; {}: {}", b.label(), g.adapter_name()));

@@ -113,10 +113,7 @@ impl Mechanics {
 
     /// Resolves the material assignments: the model index of every element, and the
     /// models in assignment order.
-    fn resolve<D: Dim>(
-        &self,
-        mesh: &Mesh<D>,
-    ) -> Result<Resolved, MechError> {
+    fn resolve<D: Dim>(&self, mesh: &Mesh<D>) -> Result<Resolved, MechError> {
         let ne = mesh.n_elements();
         if self.assignments.is_empty() {
             return Err(MechError::param(
