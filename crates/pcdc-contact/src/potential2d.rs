@@ -200,6 +200,54 @@ mod tests {
             }
         }
 
+        /// Zero force whenever a line separates the two triangles (any shapes, sizes,
+        /// orientations and gap).
+        #[test]
+        fn zero_when_apart(dir in 0.0f64..6.3, gap in 1e-9f64..0.5, r1 in 0.1f64..1.0, r2 in 0.1f64..1.0, a1 in 0.0f64..6.3, a2 in 0.0f64..6.3) {
+            let t = tri(0.0, 0.0, r2, a2);
+            let u = [dir.cos(), dir.sin()];
+            // Circumscribed circles apart by `gap`.
+            let d = r1 + r2 + gap;
+            let c = tri(d * u[0], d * u[1], r1, a1);
+            let f = triangle_pair_force(&c, &t, P);
+            prop_assert_eq!(f, PairForce2::default());
+        }
+
+        /// A frictionless, undamped pass gives back all the energy: a rigid contactor
+        /// driven head-on into the target along a line (one degree of freedom, the
+        /// force's component along the line) comes back with the speed it came in with,
+        /// to the accuracy of the central-difference integration.
+        #[test]
+        fn rebound_gives_back_the_energy(dir in 0.0f64..6.3, a1 in 0.0f64..6.3, a2 in 0.0f64..6.3, v0 in 0.5f64..2.0) {
+            let t = tri(0.0, 0.0, 1.0, a2);
+            let u = [dir.cos(), dir.sin()];
+            let (m, p) = (1.0, 1e3);
+            // Start just outside contact, moving towards the target.
+            let mut s = 2.05;
+            let mut v = -v0;
+            let dt = 1e-4;
+            let force = |s: f64| {
+                let c = tri(s * u[0], s * u[1], 1.0, a1);
+                let f = total(&triangle_pair_force(&c, &t, p).contactor);
+                f[0] * u[0] + f[1] * u[1]
+            };
+            let mut a = force(s) / m;
+            let mut steps = 0;
+            loop {
+                v += 0.5 * dt * a;
+                s += dt * v;
+                a = force(s) / m;
+                v += 0.5 * dt * a;
+                steps += 1;
+                if s >= 2.05 || steps == 200_000 {
+                    break;
+                }
+            }
+            prop_assert!(steps < 200_000, "no rebound");
+            prop_assert!(v > 0.0);
+            prop_assert!((v * v - v0 * v0).abs() <= 1e-3 * v0 * v0, "speed in {} out {}", v0, v);
+        }
+
         /// The contactor is pushed away from the target: the force on it has a positive
         /// component along the centre-to-centre direction from target to contactor, and,
         /// for shallow overlaps, grows as the overlap deepens. (Deep overlaps are not
