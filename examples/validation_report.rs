@@ -153,11 +153,33 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
+    // Jobs of every case on every available backend that have no row yet: say so.
+    let mut missing = Vec::new();
+    for b in &validation::available_backends() {
+        for case in validation::CASES {
+            let n = validation::jobs(case, b.is_gpu()).len();
+            let have = rows
+                .iter()
+                .filter(|r| {
+                    r.case == *case
+                        && format!("{}-{}", r.backend, r.precision)
+                            == b.label().replace("cpu", "cpu-f64")
+                })
+                .count();
+            if have < n {
+                missing.push(format!("{case} on {} ({have} of {n} rows)", b.label()));
+            }
+        }
+    }
+    let mut md = validation::markdown(&rows, &machine(&backends));
+    if !missing.is_empty() {
+        md.push_str(&format!(
+            "\nNot measured yet (run the command with `--resume` to add them): {}.\n",
+            missing.join("; ")
+        ));
+    }
     std::fs::create_dir_all("docs")?;
-    std::fs::write(
-        "docs/validation.md",
-        validation::markdown(&rows, &machine(&backends)),
-    )?;
+    std::fs::write("docs/validation.md", md)?;
     validation::plot(
         &rows,
         std::path::Path::new("docs/validation-error-vs-time.png"),
