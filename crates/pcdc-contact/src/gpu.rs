@@ -101,38 +101,33 @@ pub(crate) fn setup<D: Dim>(
     let ns = model.n_state().max(1);
     // Capacity: twice the largest list of the initial configuration, at least 48.
     let capacity = match input.capacity {
+        Some(0) => {
+            return Err(ComputeError::param(
+                "Contact::gpu_capacity",
+                0,
+                "must be at least 1 candidate per element",
+            ))
+        }
         Some(c) => c,
         None => {
+            // The CPU broad phase on the initial configuration (zero displacement).
+            let zeros = vec![0.0; mesh.n_nodes() * D::D];
+            let mass = vec![0.0; mesh.n_nodes()];
+            let kin = pcdc_compute::Kinematics {
+                mesh,
+                mass: &mass,
+                u: &zeros,
+                v: &zeros,
+                time: 0.0,
+                dt: 0.0,
+                step: 0,
+                damping: false,
+            };
             let margin = 0.5 * input.skin;
-            let x = mesh.coords();
-            let (d, npe) = (D::D, D::NODES_PER_ELEM);
-            // Boxes [lows, highs] of the initial elements, inflated by half the skin.
-            let boxes: Vec<([f64; 3], [f64; 3])> = mesh
-                .elements()
-                .chunks_exact(npe)
-                .map(|c| {
-                    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-                    for &n in c {
-                        for k in 0..d {
-                            lo[k] = lo[k].min(x[d * n as usize + k] - margin);
-                            hi[k] = hi[k].max(x[d * n as usize + k] + margin);
-                        }
-                    }
-                    (lo, hi)
-                })
-                .collect();
-            let lists = if d == 3 {
-                let b: Vec<[f64; 6]> = boxes
-                    .iter()
-                    .map(|(l, h)| [l[0], l[1], l[2], h[0], h[1], h[2]])
-                    .collect();
-                crate::grid_candidates_3d(&b, mesh.elements())
+            let lists = if D::D == 3 {
+                crate::grid_candidates_3d(&crate::element_boxes_3d(&kin, margin), mesh.elements())
             } else {
-                let b: Vec<[f64; 4]> = boxes
-                    .iter()
-                    .map(|(l, h)| [l[0], l[1], h[0], h[1]])
-                    .collect();
-                crate::grid_candidates(&b, mesh.elements())
+                crate::grid_candidates(&crate::element_boxes(&kin, margin), mesh.elements())
             };
             (2 * lists.iter().map(Vec::len).max().unwrap_or(0)).max(48)
         }
@@ -409,6 +404,16 @@ mod tests {
             let surface = Contact::new(1e10).surface_defaults(vec![25.0; ne], vec![1e10; ne]);
             validate_all(&m3, surface, p);
         }
+    }
+
+    /// A zero candidate capacity is a parameter error, not an invalid shader.
+    #[test]
+    fn zero_capacity_is_named() {
+        let e = sources(Contact::new(1e10).gpu_capacity(0), Precision::F64)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("gpu_capacity"), "{e}");
     }
 
     #[derive(Debug)]
