@@ -47,7 +47,7 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 use crate::model::{ContactDamping, ContactModel, Friction, MohrCoulombContact};
-use crate::{tet_pair_force, triangle_pair_force, PairForce3};
+use crate::{tet_pair_force, triangle_pair_force, PairForce2, PairForce3};
 
 /// Node positions at the last broad-phase build (m), stride D.
 pub const CONTACT_REFERENCE: &str = "contact_reference_positions";
@@ -58,7 +58,7 @@ pub const CONTACT_REFERENCE: &str = "contact_reference_positions";
 /// the normal forces are scaled to σ_n h and the shear force τ h is added along the
 /// tangent with the same weights, equal and opposite on the two triangles.
 fn apply_model<D: Dim>(
-    pair: &mut crate::PairForce2,
+    pair: &mut PairForce2,
     kin: &Kinematics<'_, D>,
     c: usize,
     t: usize,
@@ -999,8 +999,13 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
                             (&other, &me, f, e)
                         };
                         let mut pair = triangle_pair_force(c, t, model.pair_penalty(ci, ti));
-                        let h = 0.5 * (mean_edge(ci) + mean_edge(ti));
                         let state = &mut slip[k * ns..(k + 1) * ns];
+                        if pair == PairForce2::default() {
+                            // Not touching (most candidates): no force, fresh history.
+                            model.separate(state);
+                            continue;
+                        }
+                        let h = 0.5 * (mean_edge(ci) + mean_edge(ti));
                         apply_model(&mut pair, kin, ci, ti, model, h, state);
                         let share = if e < f { pair.contactor } else { pair.target };
                         for a in 0..3 {

@@ -128,9 +128,24 @@ pub fn triangle_pair_force(c: &[[f64; 2]; 3], t: &[[f64; 2]; 3], penalty: f64) -
             return out;
         }
     }
+    // Separating edge: mesh neighbours that share only a corner pass the box test but
+    // do not overlap, and are most of the candidates in an intact FDEM mesh.
+    if separated(c, t) || separated(t, c) {
+        return out;
+    }
     one_way(c, t, penalty, &mut out.contactor, &mut out.target);
     one_way(t, c, penalty, &mut out.target, &mut out.contactor);
     out
+}
+
+/// Whether some edge of `a` (counter-clockwise) has all of `b` on or outside its line:
+/// then the interiors do not overlap and the contact force is zero.
+fn separated(a: &[[f64; 2]; 3], b: &[[f64; 2]; 3]) -> bool {
+    (0..3).any(|k| {
+        let (p, q) = (a[k], a[(k + 1) % 3]);
+        b.iter()
+            .all(|x| (q[0] - p[0]) * (x[1] - p[1]) - (q[1] - p[1]) * (x[0] - p[0]) <= 0.0)
+    })
 }
 
 #[cfg(test)]

@@ -84,6 +84,25 @@ fn one_way(c: Tri, t: Tri, penalty: Real, fc: ptr<function, Tri>, ft: ptr<functi
     }
 }
 
+// Whether some edge of `a` has all of `b` on or outside its line.
+fn separated(a: Tri, b: Tri) -> bool {
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        let p = a[k];
+        let q = a[(k + 1u) % 3u];
+        var all_out = true;
+        for (var m = 0u; m < 3u; m = m + 1u) {
+            let x = b[m];
+            if (q[0] - p[0]) * (x[1] - p[1]) - (q[1] - p[1]) * (x[0] - p[0]) > 0.0 {
+                all_out = false;
+            }
+        }
+        if all_out {
+            return true;
+        }
+    }
+    return false;
+}
+
 fn triangle_pair_force(c: Tri, t: Tri, penalty: Real) -> PairForce {
     var out: PairForce;
     for (var k = 0u; k < 2u; k = k + 1u) {
@@ -94,6 +113,10 @@ fn triangle_pair_force(c: Tri, t: Tri, penalty: Real) -> PairForce {
         if cmax <= tmin || tmax <= cmin {
             return out;
         }
+    }
+    // Separating edge (see `potential2d.rs`): corner-sharing neighbours stop here.
+    if separated(c, t) || separated(t, c) {
+        return out;
     }
     var fc: Tri;
     var ft: Tri;
