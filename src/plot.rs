@@ -130,6 +130,16 @@ const FONT: &str = "sans-serif";
 /// Largest accepted image side in pixels (guards against huge allocations).
 const MAX_SIDE: u32 = 16_384;
 
+/// More series than this get their legend in a column beside the chart instead of
+/// inside it, where it would hide the data.
+const LEGEND_INSIDE_MAX: usize = 8;
+
+/// Marker of series `i`: the colours cycle every ten series and the shape (circle,
+/// triangle, square) changes with each cycle, so up to 30 series stay distinct.
+fn marker_shape(i: usize) -> usize {
+    (i / COLORS.len()) % 3
+}
+
 /// Distinct colours (matplotlib "tab10"); cycled for more series.
 const COLORS: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
@@ -350,21 +360,91 @@ impl Plot {
             std::fs::create_dir_all(dir)?;
         }
         let root = BitMapBackend::new(path, (self.width, self.height)).into_drawing_area();
+        root.fill(&WHITE).map_err(draw_err)?;
+        // Many series: the legend gets its own column on the right.
+        let (area, side) = if self.series.len() > LEGEND_INSIDE_MAX {
+            let text = self.text_size() * 0.8;
+            let longest = self.series.iter().map(|s| s.label.chars().count()).max();
+            let want = (longest.unwrap_or(0) as f64 * 0.55 + 4.0) * text;
+            let w = (want as u32).min(self.width / 2);
+            let (a, b) = root.split_horizontally(self.width - w);
+            (a, Some(b))
+        } else {
+            (root.clone(), None)
+        };
         let pos = self.legend_corner(ranges);
+        let inside = side.is_none();
         match (self.log_x, self.log_y) {
-            (false, false) => self.draw(&root, pos, x0..x1, y0..y1),
-            (true, false) => self.draw(&root, pos, (x0..x1).log_scale(), y0..y1),
-            (false, true) => self.draw(&root, pos, x0..x1, (y0..y1).log_scale()),
-            (true, true) => self.draw(&root, pos, (x0..x1).log_scale(), (y0..y1).log_scale()),
+            (false, false) => self.draw(&area, pos, inside, x0..x1, y0..y1),
+            (true, false) => self.draw(&area, pos, inside, (x0..x1).log_scale(), y0..y1),
+            (false, true) => self.draw(&area, pos, inside, x0..x1, (y0..y1).log_scale()),
+            (true, true) => self.draw(
+                &area,
+                pos,
+                inside,
+                (x0..x1).log_scale(),
+                (y0..y1).log_scale(),
+            ),
         }?;
+        if let Some(side) = side {
+            self.draw_side_legend(&side)?;
+        }
         root.present().map_err(draw_err)
     }
 
-    /// Draws everything onto `root` with the given axis specifications.
+    /// Base text size (px) for the figure's size.
+    fn text_size(&self) -> f64 {
+        (self.width.min(self.height) as f64 / 30.0).clamp(10.0, 40.0)
+    }
+
+    /// Legend in its own column: a line and marker per series, then its label.
+    fn draw_side_legend(
+        &self,
+        area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    ) -> Result<(), PlotError> {
+        let short = self.width.min(self.height) as f64;
+        let top = short / 40.0 + self.text_size() * 2.0;
+        // Every entry fits in the height: the rows (and the text) shrink if needed.
+        let room = (self.height as f64 - top - short / 40.0).max(1.0);
+        let n = self.series.len().max(1) as f64;
+        let step_f = (self.text_size() * 0.8 * 1.35).min(room / n);
+        let text = step_f / 1.35;
+        let marker = ((short / 150.0).clamp(2.0, 8.0) as i32).min((step_f / 3.0) as i32);
+        let stroke = (short / 300.0).clamp(1.0, 4.0) as u32;
+        let (step, top) = (step_f as i32, top as i32);
+        let line_w = (text * 1.6) as i32;
+        let font = (FONT, text).into_font();
+        for (i, s) in self.series.iter().enumerate() {
+            let color = COLORS[i % COLORS.len()];
+            let y = top + i as i32 * step;
+            let x = (text * 0.5) as i32;
+            if matches!(s.style, SeriesStyle::Line | SeriesStyle::LinePoints) {
+                area.draw(&PathElement::new(
+                    [(x, y), (x + line_w, y)],
+                    color.stroke_width(stroke),
+                ))
+                .map_err(draw_err)?;
+            }
+            if matches!(s.style, SeriesStyle::Points | SeriesStyle::LinePoints) {
+                draw_marker(area, (x + line_w / 2, y), marker, color, marker_shape(i))?;
+            }
+            area.draw(&Text::new(
+                s.label.as_str(),
+                (x + line_w + (text * 0.5) as i32, y - (text * 0.55) as i32),
+                font.clone(),
+            ))
+            .map_err(draw_err)?;
+        }
+        Ok(())
+    }
+
+    /// Draws everything onto `root` with the given axis specifications; the legend goes
+    /// inside the chart at `pos` when `legend_inside`.
     fn draw<X, Y>(
         &self,
         root: &DrawingArea<BitMapBackend<'_>, Shift>,
         pos: SeriesLabelPosition,
+        legend_inside: bool,
         xs: X,
         ys: Y,
     ) -> Result<(), PlotError>
@@ -374,9 +454,8 @@ impl Plot {
         X::CoordDescType: ValueFormatter<f64>,
         Y::CoordDescType: ValueFormatter<f64>,
     {
-        root.fill(&WHITE).map_err(draw_err)?;
         let short = self.width.min(self.height) as f64;
-        let text = (short / 30.0).clamp(10.0, 40.0);
+        let text = self.text_size();
         let mut chart = ChartBuilder::on(root)
             .caption(
                 &self.title,
@@ -415,9 +494,20 @@ impl Plot {
                     .map_err(draw_err)?;
             }
             if dots {
-                chart
-                    .draw_series(pts().map(|p| Circle::new(p, marker, color.filled())))
-                    .map_err(draw_err)?;
+                let (r, style) = (marker, color.filled());
+                match marker_shape(i) {
+                    1 => chart.draw_series(pts().map(|p| TriangleMarker::new(p, r + 1, style))),
+                    2 => {
+                        chart.draw_series(pts().map(|p| {
+                            EmptyElement::at(p) + Rectangle::new([(-r, -r), (r, r)], style)
+                        }))
+                    }
+                    _ => chart.draw_series(pts().map(|p| Circle::new(p, r, style))),
+                }
+                .map_err(draw_err)?;
+            }
+            if !legend_inside {
+                continue;
             }
             // Attach a zero-element series that only carries the legend entry.
             let legend_size = text as i32;
@@ -443,6 +533,9 @@ impl Plot {
                         + Circle::new((legend_size / 2, 0), marker, ms)
                 });
         }
+        if !legend_inside {
+            return Ok(());
+        }
         chart
             .configure_series_labels()
             .label_font((FONT, text * 0.9))
@@ -467,6 +560,30 @@ fn log_label(v: &f64) -> String {
         },
         _ => format!("{mantissa}e{exp}"),
     }
+}
+
+/// Draws a filled marker of `shape` ([`marker_shape`]: 0 circle, 1 triangle, 2 square)
+/// centred at pixel `at` with size `r`.
+fn draw_marker(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    at: (i32, i32),
+    r: i32,
+    color: RGBColor,
+    shape: usize,
+) -> Result<(), PlotError> {
+    let (x, y) = at;
+    match shape {
+        1 => area.draw(&Polygon::new(
+            vec![(x, y - r - 1), (x - r - 1, y + r), (x + r + 1, y + r)],
+            color.filled(),
+        )),
+        2 => area.draw(&Rectangle::new(
+            [(x - r, y - r), (x + r, y + r)],
+            color.filled(),
+        )),
+        _ => area.draw(&Circle::new((x, y), r, color.filled())),
+    }
+    .map_err(draw_err)
 }
 
 fn draw_err(e: impl std::fmt::Display) -> PlotError {
@@ -622,5 +739,31 @@ mod tests {
             p.save_png(tmp("d.png")),
             Err(PlotError::InvalidSize(0, 10))
         ));
+    }
+}
+
+#[cfg(test)]
+mod legend_tests {
+    use super::*;
+
+    #[test]
+    fn many_series_get_distinct_markers_and_a_side_legend() {
+        // Same colour every ten series, so the shape must differ.
+        for i in 0..20 {
+            assert_ne!(marker_shape(i), marker_shape(i + COLORS.len()));
+        }
+        let dir = std::env::temp_dir().join(format!("pcdc_legend_{}", std::process::id()));
+        let path = dir.join("many.png");
+        let mut p = Plot::new("many", "x", "y").log_y(true).size(800, 500);
+        for k in 0..30 {
+            let x: Vec<f64> = (1..=5).map(|i| i as f64).collect();
+            let y = x.iter().map(|t| (k as f64 + 1.0) * t).collect();
+            p = p.line_points(format!("a rather long series label number {k}"), x, y);
+        }
+        p.save_png(&path).unwrap();
+        let b = std::fs::read(&path).unwrap();
+        let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+        assert_eq!((be(16), be(20)), (800, 500));
+        let _ = std::fs::remove_dir_all(dir);
     }
 }

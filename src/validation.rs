@@ -481,7 +481,7 @@ pub fn plot(rows: &[Row], path: &Path) -> Result<(), SceneError> {
     )
     .log_x(true)
     .log_y(true)
-    .size(1400, 900);
+    .size(1500, 1000);
     for (label, x, y) in groups {
         // Sort by time so the line joins the mesh sizes in order.
         let mut pts: Vec<(f64, f64)> = x.into_iter().zip(y).collect();
