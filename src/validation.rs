@@ -182,7 +182,7 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
             }
         }
         // The reduced loading of the tests at three coarse meshes (the full 2 mm scenes
-        // are the examples: about 4 and 5 minutes on 2 idle cores).
+        // are the examples: about 2 and 1 minutes on 2 idle cores).
         "ucs" => {
             for size in [0.006, 0.005, 0.004] {
                 out.push(j("ucs", "E vs input; UCS/Ts", size));
