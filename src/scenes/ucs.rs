@@ -124,8 +124,7 @@ pub fn equilateral_rectangle(
     height: f64,
     size: f64,
 ) -> Result<pcdc_mesh::Mesh<pcdc_mesh::Dim2>, SceneError> {
-    let nx = (width / size).ceil().max(1.0) as usize;
-    let ny = (height / (size * 0.75f64.sqrt())).ceil().max(1.0) as usize;
+    let (nx, ny) = cell_counts(width, height, size, size * 0.75f64.sqrt())?;
     let (dx, dy) = (width / nx as f64, height / ny as f64);
     let mut coords = Vec::new();
     let mut rows: Vec<Vec<u32>> = Vec::with_capacity(ny + 1);
@@ -190,8 +189,8 @@ pub fn crossed_rectangle(
     size: f64,
     aspect: f64,
 ) -> Result<pcdc_mesh::Mesh<pcdc_mesh::Dim2>, SceneError> {
-    let nx = (width / size).ceil().max(1.0) as usize;
-    let ny = (height / (aspect * size)).ceil().max(1.0) as usize;
+    positive("aspect", aspect)?;
+    let (nx, ny) = cell_counts(width, height, size, aspect * size)?;
     let (dx, dy) = (width / nx as f64, height / ny as f64);
     let mut coords = Vec::with_capacity(2 * (nx + 1) * (ny + 1));
     for j in 0..=ny {
@@ -212,6 +211,29 @@ pub fn crossed_rectangle(
         }
     }
     Ok(pcdc_mesh::Mesh::new(coords, conn)?)
+}
+
+/// Largest number of cells the rectangle builders accept (guards the allocation).
+const MAX_CELLS: f64 = 1e8;
+
+/// Columns and rows, `ceil(width / sx)` and `ceil(height / sy)` (at least 1), of a
+/// rectangle builder; an error names the bad input instead of a panic or a huge
+/// allocation.
+fn cell_counts(width: f64, height: f64, sx: f64, sy: f64) -> Result<(usize, usize), SceneError> {
+    positive("width", width)?;
+    positive("height", height)?;
+    positive("mesh size", sx)?;
+    positive("mesh size", sy)?;
+    let (nx, ny) = ((width / sx).ceil().max(1.0), (height / sy).ceil().max(1.0));
+    if nx * ny > MAX_CELLS {
+        return Err(ParamError {
+            key: "sample.mesh_size".into(),
+            value: sx,
+            reason: "gives more than 1e8 cells",
+        }
+        .into());
+    }
+    Ok((nx as usize, ny as usize))
 }
 
 /// Height / width of the cells of [`MeshPattern::SteepCrossed`].
@@ -867,6 +889,22 @@ mod tests {
             let nodes = mesh.element(e);
             assert!(diagonal.iter().all(|n| nodes.contains(n)), "{e}: {nodes:?}");
         }
+    }
+
+    #[test]
+    fn rectangle_builders_reject_bad_sizes() {
+        for size in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-9] {
+            assert!(
+                crossed_rectangle(0.0, 0.0, 0.05, 0.1, size, 2.0).is_err(),
+                "{size}"
+            );
+            assert!(
+                equilateral_rectangle(0.0, 0.0, 0.05, 0.1, size).is_err(),
+                "{size}"
+            );
+        }
+        assert!(crossed_rectangle(0.0, 0.0, 0.05, 0.1, 0.01, 0.0).is_err());
+        assert!(crossed_rectangle(0.0, 0.0, -0.05, 0.1, 0.01, 2.0).is_err());
     }
 
     #[test]
