@@ -61,3 +61,51 @@ fn reduced_ucs_modulus_within_tolerance_and_finite_peak() {
     );
     assert!(out.broken.total() > 0, "no joint broke");
 }
+
+/// The platen scenes on the GPU run in chunks between reaction reads
+/// (`platen_test::reaction_chunk`); the loading branch up to ~30 % of the peak must
+/// follow the CPU's (f64, 6 mm mesh). Skips with a printed reason without a GPU.
+#[test]
+fn gpu_loading_branch_follows_the_cpu() {
+    let Some(gpu) = pcdc::compute::gpu::gpu_test_backend(Some(pcdc::compute::Precision::F64))
+    else {
+        return;
+    };
+    let mut p = ucs::Params::reduced();
+    p.sample.mesh_size = 0.006;
+    p.loading.max_closure = 3e-4;
+    let cpu = ucs::run(&CpuBackend::new(2).unwrap(), &p, &mut |_| {}).unwrap();
+    let dev = ucs::run(&gpu, &p, &mut |_| {}).unwrap();
+    assert_eq!(cpu.stress.len(), dev.stress.len());
+    let top = cpu.stress.iter().fold(0.0f64, |m, s| m.max(s.abs()));
+    let worst = cpu
+        .stress
+        .iter()
+        .zip(&dev.stress)
+        .map(|(a, b)| (a - b).abs() / top)
+        .fold(0.0f64, f64::max);
+    let strain = cpu
+        .strain
+        .iter()
+        .zip(&dev.strain)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f64, f64::max)
+        / cpu.strain.last().unwrap().abs();
+    eprintln!(
+        "ucs loading branch gpu vs cpu: {} samples to {:.2} MPa, stress max diff {:.2e} of the top, strain {:.2e}, E {:.4} vs {:.4} GPa, wall {:.1} / {:.1} s",
+        cpu.stress.len(),
+        top / 1e6,
+        worst,
+        strain,
+        cpu.young / 1e9,
+        dev.young / 1e9,
+        cpu.wall_s,
+        dev.wall_s
+    );
+    // The positions agree to round-off; the load is a mean over each window of
+    // every step (CPU) or ten reads (GPU), which differ by the load's rise within a
+    // tenth of a window.
+    assert!(strain < 1e-9, "strain differs by {strain:e}");
+    assert!(worst < 2e-3, "stress differs by {worst:e} of the top");
+    assert!((cpu.young - dev.young).abs() < 2e-3 * cpu.young);
+}
