@@ -218,6 +218,9 @@ pub fn run_job<B: Backend>(backend: &B, job: &Job) -> Result<Row, SceneError> {
         steps,
         wall_s: start.elapsed().as_secs_f64(),
     };
+    // A row whose error passes at most `tol` (a fraction).
+    let within =
+        |elements, error: f64, tol: f64, steps| row(elements, error, pct(tol), error <= tol, steps);
     Ok(match job.case {
         "kirsch" => {
             let solver = if job.variant == "direct" {
@@ -230,13 +233,7 @@ pub fn run_job<B: Backend>(backend: &B, job: &Job) -> Result<Row, SceneError> {
                 ..kirsch::Params::full()
             };
             let o = kirsch::run(backend, &p, solver)?;
-            row(
-                o.elements,
-                o.error,
-                pct(kirsch::TOL),
-                o.error <= kirsch::TOL,
-                o.steps,
-            )
+            within(o.elements, o.error, kirsch::TOL, o.steps)
         }
         "wave_speed" => {
             let p = wave_speed::Params { size: job.size };
@@ -245,13 +242,7 @@ pub fn run_job<B: Backend>(backend: &B, job: &Job) -> Result<Row, SceneError> {
             } else {
                 wave_speed::run_3d(backend, &p)?
             };
-            row(
-                o.elements,
-                o.error,
-                pct(wave_speed::TOL),
-                o.error <= wave_speed::TOL,
-                o.steps,
-            )
+            within(o.elements, o.error, wave_speed::TOL, o.steps)
         }
         "vibration_energy" => {
             let p = vibration_energy::Params {
@@ -263,23 +254,11 @@ pub fn run_job<B: Backend>(backend: &B, job: &Job) -> Result<Row, SceneError> {
             } else {
                 vibration_energy::run_3d(backend, &p)?
             };
-            row(
-                o.elements,
-                o.drift,
-                pct(vibration_energy::TOL),
-                o.drift <= vibration_energy::TOL,
-                o.steps,
-            )
+            within(o.elements, o.drift, vibration_energy::TOL, o.steps)
         }
         "block_sliding" => {
             let o = block_sliding::run_sized(backend, 1.0, job.size)?;
-            row(
-                o.elements,
-                o.error,
-                pct(block_sliding::TOL),
-                o.error <= block_sliding::TOL,
-                o.steps,
-            )
+            within(o.elements, o.error, block_sliding::TOL, o.steps)
         }
         "direct_tension" => {
             let p = direct_tension::Params {
