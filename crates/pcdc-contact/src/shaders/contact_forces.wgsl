@@ -112,6 +112,18 @@ fn apply_model(pair: ptr<function, PairForce>, c: u32, t: u32, h: Real, state: p
     }
 }
 
+// True when every force of the pair is zero (the CPU's `pair == PairForce2::default()`).
+fn is_zero(pair: PairForce) -> bool {
+    for (var a = 0u; a < 3u; a = a + 1u) {
+        for (var d = 0u; d < 2u; d = d + 1u) {
+            if pair.c[a][d] != 0.0 || pair.t[a][d] != 0.0 {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
 fn kernel(e: u32) {
     var own: Tri;
     let me = element_xy(e);
@@ -137,9 +149,16 @@ fn kernel(e: u32) {
             t = me;
         }
         var pair = triangle_pair_force(c, t, pair_penalty(ci, ti, MODEL_AT));
-        let h = 0.5 * (mean_edge(c) + mean_edge(t));
         var state: ContactState;
         let base = (e * CAP + k) * NSTATE;
+        if is_zero(pair) {
+            // Not touching (most candidates): no force, fresh history (as on the CPU).
+            for (var s = 0u; s < NSTATE; s = s + 1u) {
+                hist[base + s] = 0.0;
+            }
+            continue;
+        }
+        let h = 0.5 * (mean_edge(c) + mean_edge(t));
         for (var s = 0u; s < NSTATE; s = s + 1u) {
             state[s] = hist[base + s];
         }
