@@ -12,6 +12,12 @@
 //! joint, for output), and `broken_face` (1 on both faces of a fully broken joint, on
 //! the split mesh's faces: the field contact picks up).
 //!
+//! A broken joint (largest damage 1) transfers no force from the next step on, whatever
+//! its model: its faces interact through contact alone. Integrating it further would
+//! let an overlap penalty push faces that have separated and moved far apart (the
+//! opening of a broken joint's face pair means nothing once the faces have left each
+//! other), which injects energy into fragmenting runs.
+//!
 //! On the GPU backend one kernel (`shaders/joints.wgsl`, one invocation per joint)
 //! repeats this arithmetic in the same order, with each model's WGSL body
 //! ([`crate::WgslJointModel`]) spliced in; it writes the same slots and fields.
@@ -373,6 +379,10 @@ impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
         })
     }
 
+    fn slot_entity(&self, slot: usize) -> Option<String> {
+        Some(format!("joint {}", slot / (2 * D::NODES_PER_FACE)))
+    }
+
     fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
         let [sid, did, bid] = self.ids.expect("init ran");
         let (d, npf) = (D::D, D::NODES_PER_FACE);
@@ -389,12 +399,13 @@ impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
                 .for_each(|(c, ((sl, st), dm))| {
                     for i in 0..dm.len() {
                         let j = c * CHUNK + i;
-                        dm[i] = self.joint::<D>(
-                            j,
-                            kin,
-                            &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d],
-                            &mut st[i * stride..(i + 1) * stride],
-                        );
+                        let sl = &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d];
+                        if dm[i] >= 1.0 {
+                            // Broken: no force; contact alone acts between its faces.
+                            sl.fill(0.0);
+                            continue;
+                        }
+                        dm[i] = self.joint::<D>(j, kin, sl, &mut st[i * stride..(i + 1) * stride]);
                     }
                 })
         });

@@ -40,6 +40,12 @@ if o > op || s > sp {
         (*state)[0] = d;
     }
 }
+// A broken joint transfers nothing: its faces interact through contact alone.
+if d >= 1.0 {
+    var none: JointTraction;
+    none.damage = d;
+    return none;
+}
 var f = Real(1.0);
 if d > 0.0 {
     f = softening(d);

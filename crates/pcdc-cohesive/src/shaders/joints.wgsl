@@ -5,7 +5,8 @@
 // the slip s = δ − o n; the model gives σ and the shear vector; side A receives
 // w A N_k (σ n + τ) and side B the opposite. Writes every slot of the joint, the joint
 // history, the joint damage (largest over the Gauss points) and, once broken, 1 on
-// both faces in `broken_face`.
+// both faces in `broken_face`. A joint already broken at the start of the step writes
+// zero slots and nothing else.
 //
 // joint_info, stride INFO: side A nodes (NPF), side B nodes (NPF), faces A and B,
 // model kind, parameter offset. joint_data: Gauss points (N_0, N_1, N_2, weight) from
@@ -13,6 +14,15 @@
 
 fn kernel(j: u32) {
     let r = j * INFO;
+    let s0 = (SLOT_FIRST + 2u * NPF * j) * D;
+    // A broken joint (largest damage 1, faces flagged) transfers no force: contact alone
+    // acts between its faces.
+    if joint_damage[j] >= 1.0 {
+        for (var i = 0u; i < 2u * NPF * D; i = i + 1u) {
+            slots[s0 + i] = Real(0.0);
+        }
+        return;
+    }
     var mid: array<Real, 9>;
     var gap: array<Real, 9>;
     for (var k = 0u; k < NPF; k = k + 1u) {
@@ -74,7 +84,6 @@ fn kernel(j: u32) {
             }
         }
     }
-    let s0 = (SLOT_FIRST + 2u * NPF * j) * D;
     for (var i = 0u; i < 2u * NPF * D; i = i + 1u) {
         slots[s0 + i] = f[i];
     }
