@@ -32,6 +32,18 @@ pub enum ComputeError {
         entity: String,
         hint: String,
     },
+    /// The energy watchdog stopped the run: the total energy exceeds the initial energy
+    /// plus the external work by more than the tolerance (see [`crate::EnergyBalance`]).
+    #[error("energy growth at step {step} (t = {time:e} s): total energy exceeds the initial energy plus the external work by {excess:e} J, more than {tolerance} of the reference {reference:e} J; injected by {physics}{}. Hint: a force that acts where it should not (e.g. between faces that have separated), a penalty too stiff for the time step, or a time step above the stable one", if entity.is_empty() { String::new() } else { format!(" at {entity}") })]
+    EnergyGrowth {
+        step: u64,
+        time: f64,
+        excess: f64,
+        reference: f64,
+        tolerance: f64,
+        physics: String,
+        entity: String,
+    },
     /// No physics limits the time step and none was given.
     #[error("no stable time step: no composed physics reports one; set it with SimulationBuilder::time_step")]
     NoTimeStep,

@@ -17,6 +17,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod backend;
+mod energy;
 mod error;
 mod field;
 pub mod gpu;
@@ -27,6 +28,7 @@ mod statics;
 mod table;
 
 pub use backend::{Backend, BackendKind, CpuBackend};
+pub use energy::{EnergyBalance, PhysicsEnergy, ENERGY_CHECK_EVERY};
 pub use error::ComputeError;
 pub use field::{names, FieldId, FieldSpec, FieldStore, Location};
 pub use gpu::{BackendChoice, Precision, WgpuBackend};

@@ -218,4 +218,17 @@ pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
     fn stored_energy(&self, _kin: &Kinematics<'_, D>, _fields: &FieldStore) -> f64 {
         0.0
     }
+
+    /// Whether this physics' forces are applied loads (face tractions, point loads):
+    /// the energy balance counts their work as external work instead of energy the
+    /// physics absorbs (default: internal forces of a body).
+    fn applies_loads(&self) -> bool {
+        false
+    }
+
+    /// Names the entity that owns slot `slot` of this physics' slot block (e.g.
+    /// "joint 12", "element 7"), for the energy watchdog's message; `None`: the slot.
+    fn slot_entity(&self, _slot: usize) -> Option<String> {
+        None
+    }
 }

@@ -12,6 +12,7 @@ use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::energy::EnergyTracker;
 use crate::gpu::GpuRun;
 use crate::physics::{ForceContext, InitContext, Kinematics, VelocityContext};
 use crate::{Backend, ComputeError, CpuBackend, FieldStore, Physics, StableStep};
@@ -44,6 +45,7 @@ pub struct SimulationBuilder<D: Dim, B: Backend = CpuBackend> {
     fixed_dt: Option<f64>,
     runaway: Option<f64>,
     local_damping: f64,
+    energy: Option<Option<f64>>,
 }
 
 impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
@@ -58,7 +60,30 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             fixed_dt: None,
             runaway: None,
             local_damping: 0.0,
+            energy: None,
         }
+    }
+
+    /// Tracks the energy balance ([`crate::EnergyBalance`], read with
+    /// [`Simulation::energy_balance`]): the work of every force source accumulated each
+    /// step (one extra pass over the nodes and force slots), stored energies evaluated
+    /// every [`crate::ENERGY_CHECK_EVERY`] steps. Off by default.
+    pub fn track_energy(mut self) -> Self {
+        if self.energy.is_none() {
+            self.energy = Some(None);
+        }
+        self
+    }
+
+    /// Tracks the energy balance and stops the run with
+    /// [`ComputeError::EnergyGrowth`] (naming the step, the physics and the entity that
+    /// injects energy) when the total energy exceeds the initial energy plus the
+    /// external work by more than `tolerance` (relative, e.g. 0.01) of the reference
+    /// energy max(E_0 + W_ext, largest total so far). Checked every
+    /// [`crate::ENERGY_CHECK_EVERY`] steps.
+    pub fn energy_watchdog(mut self, tolerance: f64) -> Self {
+        self.energy = Some(Some(tolerance));
+        self
     }
 
     /// Adds a physics. Physics run in the order they are added (this fixes the
@@ -119,7 +144,17 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             fixed_dt,
             runaway,
             local_damping,
+            energy,
         } = self;
+        if let Some(Some(tol)) = energy {
+            if !(tol > 0.0 && tol.is_finite()) {
+                return Err(ComputeError::param(
+                    "energy_watchdog tolerance",
+                    tol,
+                    "must be positive and finite (relative, e.g. 0.01)",
+                ));
+            }
+        }
         if !(0.0..1.0).contains(&local_damping) {
             return Err(ComputeError::param(
                 "local_damping",
@@ -208,6 +243,7 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             limit: None,
             damping: true,
             local_damping,
+            energy: energy.map(|tol| Box::new(EnergyTracker::new(tol, &layout.slot_ranges))),
         };
         sim.update_time_step()?;
         if let Some(gpu) = sim.backend.as_gpu().cloned() {
@@ -307,6 +343,8 @@ pub struct Simulation<D: Dim, B: Backend = CpuBackend> {
     /// True only between an internal read-back and the next internal device call that
     /// may skip its upload (relaxation loop); public entry points always upload.
     pub(crate) device_fresh: bool,
+    /// Energy balance accumulators, when tracking is on.
+    pub(crate) energy: Option<Box<EnergyTracker>>,
 }
 
 /// Snapshot file header, checked on restore.
@@ -338,8 +376,10 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
             return self.run(1);
         }
         self.physics_forces()?;
+        self.energy_before_update();
         self.gather(true);
-        self.finish_step()
+        self.finish_step()?;
+        self.energy_after_step()
     }
 
     /// Advances `n` steps. On the GPU backend the host state (`state`, masses) is

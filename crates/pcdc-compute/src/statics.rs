@@ -112,8 +112,15 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
         let saved_alpha = self.local_damping;
         self.local_damping = RELAX_DAMPING;
         self.state.v.fill(0.0);
+        // Relaxation is not a physical process (scaled masses, pseudo-time): the energy
+        // balance pauses and restarts from the relaxed state.
+        let energy = self.energy.take();
         let free = self.free_dofs();
         let result = self.relax_loop(opts, &free);
+        self.energy = energy.map(|mut t| {
+            t.rebase();
+            t
+        });
         self.device_fresh = false;
         self.mass = self.mass_phys.clone();
         self.local_damping = saved_alpha;

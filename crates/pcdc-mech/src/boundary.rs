@@ -244,6 +244,11 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
         "mechanical boundary"
     }
 
+    /// Face tractions and node forces are applied loads: external work.
+    fn applies_loads(&self) -> bool {
+        true
+    }
+
     fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
         if self
             .items

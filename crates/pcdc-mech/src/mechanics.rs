@@ -799,6 +799,10 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
         Ok(true)
     }
 
+    fn slot_entity(&self, slot: usize) -> Option<String> {
+        Some(format!("element {}", slot / D::NODES_PER_ELEM))
+    }
+
     fn stored_energy(&self, _kin: &Kinematics<'_, D>, fields: &FieldStore) -> f64 {
         let ids = self.ids();
         let (st, ep, ex) = (

@@ -20,6 +20,7 @@
 //! `atomicMin`s of the divergence watchdog.
 
 mod backend;
+mod energy;
 mod program;
 mod run;
 

@@ -153,6 +153,16 @@ pub(crate) struct GpuRun {
     record_bytes: u64,
     staging: wgpu::Buffer,
     max_groups: u32,
+    /// Energy-balance kernels and buffers, when tracking is on.
+    energy: Option<GpuEnergy>,
+}
+
+/// The energy-balance kernels of a run (see `gpu/energy.rs`).
+struct GpuEnergy {
+    save: Pipeline,
+    work: Pipeline,
+    buffers: super::energy::EnergyBuffers,
+    staging: wgpu::Buffer,
 }
 
 fn real_bytes(v: &[f64], p: Precision) -> Vec<u8> {
@@ -198,12 +208,21 @@ impl GpuRun {
         let device = backend.device();
         let limits = backend.limits().clone();
         let Program {
-            buffers: decls,
+            buffers: mut decls,
             field_buffers,
             kernels,
             signals,
             errors,
         } = program;
+        // Energy balance buffers, only when tracking is on.
+        let energy_buffers = sim.energy.is_some().then(|| {
+            super::energy::declare(
+                &mut decls,
+                sim.mesh.n_nodes(),
+                D::D,
+                layout.slot_ranges.len(),
+            )
+        });
         let eb = |e: Elem| match e {
             Elem::Real => precision.bytes(),
             Elem::U32 | Elem::Atomic => 4,
@@ -386,6 +405,25 @@ impl GpuRun {
                 make(&k)
             })
             .collect::<Result<Vec<_>, _>>()?;
+        let energy = match energy_buffers {
+            Some(b) => {
+                let [save, work] =
+                    super::energy::kernels(&b, sim.mesh.n_nodes(), D::D, &layout.slot_ranges);
+                let staging = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("energy read-back"),
+                    size: buffers[b.acc].size(),
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                Some(GpuEnergy {
+                    save: make(&save)?,
+                    work: make(&work)?,
+                    buffers: b,
+                    staging,
+                })
+            }
+            None => None,
+        };
         let update = builtins.pop().expect("three built-ins");
         let gather_forces = builtins.pop().expect("three built-ins");
         let gather_integrate = builtins.pop().expect("three built-ins");
@@ -427,6 +465,7 @@ impl GpuRun {
             record_bytes: record_bytes as u64,
             staging,
             max_groups: limits.max_compute_workgroups_per_dimension.max(1),
+            energy,
         };
         let mass_phys = real_bytes(&sim.mass_phys, precision);
         backend
@@ -524,6 +563,14 @@ impl GpuRun {
         }
         self.sync_to_device(sim);
         self.reset_status();
+        // Energy balance: on while the simulation tracks it (paused during relaxation).
+        let energy_on = self.energy.is_some() && sim.energy.is_some();
+        if energy_on {
+            if let Some(mut t) = sim.energy.take() {
+                sim.energy_baseline(&mut t);
+                sim.energy = Some(t);
+            }
+        }
         let (t0, step0) = (sim.state.time, sim.state.step);
         let (mut t, mut step) = (t0, step0);
         let mut left = n;
@@ -561,9 +608,16 @@ impl GpuRun {
                     for p in &self.forces {
                         self.dispatch(&mut pass, p);
                     }
+                    let energy = self.energy.as_ref().filter(|_| energy_on);
+                    if let Some(e) = energy {
+                        self.dispatch(&mut pass, &e.save);
+                    }
                     self.dispatch(&mut pass, &self.gather_integrate);
                     for p in &self.kinematics {
                         self.dispatch(&mut pass, p);
+                    }
+                    if let Some(e) = energy {
+                        self.dispatch(&mut pass, &e.work);
                     }
                     self.dispatch(&mut pass, &self.update);
                 }
@@ -589,7 +643,56 @@ impl GpuRun {
             let nonfinite = status[1] % 2 == 0;
             return Err(sim.divergence(bad_step, tb, node as usize, nonfinite));
         }
+        if energy_on {
+            let works = self.read_energy()?;
+            if let Some(mut t) = sim.energy.take() {
+                let loads: Vec<bool> = sim.physics.iter().map(|p| p.applies_loads()).collect();
+                let np = loads.len() + 3;
+                t.add_works(&works[..np], &loads);
+                t.forward.clear();
+                t.forward.extend_from_slice(&works[np..]);
+                let verdict = sim.energy_check(&mut t);
+                sim.energy = Some(t);
+                verdict?;
+            }
+        }
         Ok(())
+    }
+
+    /// Reads the energy accumulators, sums them in node order and zeroes them.
+    fn read_energy(&self) -> Result<Vec<f64>, ComputeError> {
+        let e = self.energy.as_ref().expect("energy kernels");
+        let device = self.backend.device();
+        let acc = &self.buffers[e.buffers.acc];
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("energy read-back"),
+        });
+        enc.copy_buffer_to_buffer(acc, 0, &e.staging, 0, acc.size());
+        enc.clear_buffer(acc, 0, None);
+        self.backend.queue().submit([enc.finish()]);
+        let slice = e.staging.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|err| ComputeError::Gpu(format!("device lost while waiting: {err}")))?;
+        rx.recv()
+            .map_err(|err| ComputeError::Gpu(format!("energy read-back failed: {err}")))?
+            .map_err(|err| ComputeError::Gpu(format!("energy read-back failed: {err}")))?;
+        let n = (acc.size() as usize) / self.precision.bytes();
+        let mut values = vec![0.0; n];
+        {
+            let data = slice.get_mapped_range().map_err(|err| {
+                ComputeError::Gpu(format!("energy read-back mapping failed: {err}"))
+            })?;
+            reals_from(&data, self.precision, &mut values);
+        }
+        e.staging.unmap();
+        let per = e.buffers.per_node;
+        let used = (n / (2 * per)) * 2 * per;
+        Ok(super::energy::sum_nodes(&values[..used], per))
     }
 
     /// Evaluates the forces at the current state (no step), reads back state, node force
