@@ -10,6 +10,11 @@
 //! `Mesh<Dim3>` (sorted-grid broad phase with a skin, deterministic element-centric
 //! assembly, bonded-neighbour exclusion for FDEM regions), on the CPU and GPU backends.
 //!
+//! **Corrected equation.** The manual's friction law eq. 59, τ = P_t h |δ_s|, is not a
+//! stress and would make results depend on the unit system; the crate uses
+//! τ = P_t |δ_s| / h (P_t in Pa, like the joints' shear penalty), see [`Friction`]. The
+//! contact stable step accounts for that tangential spring.
+//!
 //! Contact without a contact law uses the elements' own surface friction and penalty
 //! (manual table 1): [`Contact::surface_defaults`] with [`SurfaceContact`].
 //!

@@ -29,6 +29,12 @@ pub trait ContactModel: Send + Sync + Debug {
     fn name(&self) -> &str;
     /// Normal penalty P_n of the contact potential (Pa).
     fn normal_penalty(&self) -> f64;
+    /// Largest tangential (shear) penalty P_t of the law (Pa; τ = P_t δ_s / h before
+    /// sliding), used with the normal penalty to bound the stable time step; default 0
+    /// (no tangential spring).
+    fn shear_penalty(&self) -> f64 {
+        0.0
+    }
     /// History values per pair (carried across broad-phase rebuilds and snapshots).
     fn n_state(&self) -> usize {
         0
@@ -123,13 +129,24 @@ fn damping_power(x: f64, b: f64) -> f64 {
     }
 }
 
-/// Coulomb friction with a shear penalty (manual eq. 59-60).
+/// Coulomb friction with a shear penalty (manual eq. 59-60, eq. 59 corrected).
+///
+/// **Correction of eq. 59.** The manual prints τ = P_t h |δ_s|, which is not a stress
+/// (Pa·m² with P_t in Pa): the tangential stiffness would then scale with h² in whatever
+/// length unit the user picked, and the same scene in metres and in millimetres would
+/// slide differently. We use the dimensionally consistent
+///
+/// τ = P_t |δ_s| / h  (until τ reaches tan φ σ_n, eq. 60),
+///
+/// the same form as the joints' shear penalty (eq. 64, slope 2c/s_p = P_tan/h): P_t is a
+/// stress (Pa), comparable to the normal penalty, and δ_s / h a tangential strain.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Friction {
     /// Friction angle φ (degrees).
     pub angle_deg: f64,
-    /// Shear penalty P_t (Pa/m): the shear stress grows as P_t h |δ_s| until it reaches
-    /// tan φ σ_n (h the contact length).
+    /// Shear penalty P_t (Pa): the shear stress grows as P_t |δ_s| / h until it reaches
+    /// tan φ σ_n (h the contact length, δ_s the accumulated slip). The manual's default
+    /// for the normal penalty, 10 E, is a sensible value here too.
     pub penalty: f64,
 }
 
@@ -171,6 +188,9 @@ impl ContactModel for MohrCoulombContact {
     }
     fn normal_penalty(&self) -> f64 {
         self.normal_penalty
+    }
+    fn shear_penalty(&self) -> f64 {
+        self.friction.map_or(0.0, |f| f.penalty)
     }
     fn n_state(&self) -> usize {
         3
@@ -232,9 +252,10 @@ impl ContactModel for MohrCoulombContact {
         };
         let mut shear = 0.0;
         if let Some(fr) = self.friction {
-            // eq. 59: τ = P_t h |δ_s| up to tan φ σ_n; eq. 60: δ_s reset to the limit.
+            // eq. 59 (corrected, see [`Friction`]): τ = P_t |δ_s| / h up to tan φ σ_n;
+            // eq. 60: δ_s reset to the limit.
             state[0] += dslip;
-            let kt = fr.penalty * h;
+            let kt = fr.penalty / h;
             let limit = fr.angle_deg.to_radians().tan() * normal;
             let mut t = kt * state[0].abs();
             if t > limit {
@@ -302,6 +323,9 @@ impl ContactModel for SurfaceContact {
     }
     fn normal_penalty(&self) -> f64 {
         self.penalty.iter().fold(0.0, |m, &p| m.max(p))
+    }
+    fn shear_penalty(&self) -> f64 {
+        self.normal_penalty()
     }
     fn n_state(&self) -> usize {
         3

@@ -30,7 +30,7 @@
 //!   total normal force; the tangential direction is that of the pair's relative
 //!   tangential velocity v_t = v_rel − (v_rel · n) n, and the slip increment is
 //!   Δδ = |v_t| Δt ≥ 0 along it. The accumulated slip δ_s of the law is therefore a
-//!   scalar along the current sliding direction: the shear force min(P_t h |δ_s|,
+//!   scalar along the current sliding direction: the shear force min(P_t |δ_s| / h,
 //!   tan φ σ_n) h² always opposes the current sliding velocity (purely dissipative, no
 //!   stored tangential spring force when the sliding direction turns), and no shear acts
 //!   while v_t = 0.
@@ -275,7 +275,8 @@ impl Contact {
         })
     }
 
-    /// Adds Coulomb friction (eq. 59-60).
+    /// Adds Coulomb friction (eq. 59-60, eq. 59 corrected): friction angle (degrees) and
+    /// shear penalty P_t (Pa; τ = P_t δ_s / h before sliding, 10 E is a sensible value).
     pub fn friction(mut self, angle_deg: f64, shear_penalty: f64) -> Self {
         self.friction = Some(Friction {
             angle_deg,
@@ -357,8 +358,14 @@ impl Contact {
     /// pressed together. (Measured on an impact of two FDEM cubes, every tetrahedron
     /// with its own nodes: the single-face estimate was the critical step itself; this
     /// one is √2 below it, before the simulation's safety factor.)
-    fn stable_step_3d<D: Dim>(kin: &Kinematics<'_, D>, penalty: f64) -> StableStep {
+    ///
+    /// The friction spring (eq. 59 corrected) gives a pair the tangential stiffness
+    /// τ h² / δ_s = P_t h, h the mean edge length of the two elements: a node sums
+    /// P_t × its elements' longest edge, and takes the larger of its normal and
+    /// tangential sums (they act in orthogonal directions).
+    fn stable_step_3d<D: Dim>(kin: &Kinematics<'_, D>, penalty: f64, shear: f64) -> StableStep {
         let mut k = vec![0.0; kin.mesh.n_nodes()];
+        let mut kt = vec![0.0; kin.mesh.n_nodes()];
         for e in 0..kin.mesh.n_elements() {
             let t = Self::element_xyz(kin, e);
             let edge =
@@ -378,12 +385,20 @@ impl Contact {
                 .iter()
                 .map(|&(a, b, d)| 0.5 * norm(cross(edge(a, b), edge(a, d))))
                 .fold(0.0, f64::max);
+            let edge_max = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+                .iter()
+                .map(|&(a, b)| norm(edge(a, b)))
+                .fold(0.0, f64::max);
             if vol > 0.0 {
                 let ke = 16.0 / 9.0 * penalty * area_max * area_max / vol;
                 for &n in kin.mesh.element(e) {
                     k[n as usize] += ke;
+                    kt[n as usize] += shear * edge_max;
                 }
             }
+        }
+        for (kn, &t) in k.iter_mut().zip(&kt) {
+            *kn = kn.max(t);
         }
         let (mut best, mut which) = (f64::INFINITY, 0);
         for (n, (&m, &kn)) in kin.mass.iter().zip(&k).enumerate() {
@@ -835,19 +850,30 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         Ok(())
     }
 
+    fn slot_entity(&self, slot: usize) -> Option<String> {
+        Some(format!(
+            "contact forces on element {}",
+            slot / D::NODES_PER_ELEM
+        ))
+    }
+
     fn stable_step(&self, kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
         // A node pushed by the potential of a neighbour's sub-triangle (gradient 3/h over
-        // an edge of length ~h) sees a stiffness of about 3 p per unit thickness.
-        let penalty = self
-            .model
-            .as_ref()
-            .map_or(self.penalty, |m| m.normal_penalty());
+        // an edge of length ~h) sees a normal stiffness of about 3 p per unit thickness.
+        // The friction spring (eq. 59 corrected: τ h = P_t δ_s per unit thickness) adds
+        // at most P_t along the tangent, orthogonal to the normal: the node's stiffness
+        // is the larger of the two.
+        let (penalty, shear) = self.model.as_ref().map_or(
+            (self.penalty, self.friction.map_or(0.0, |f| f.penalty)),
+            |m| (m.normal_penalty(), m.shear_penalty()),
+        );
         if D::D == 3 {
-            return Some(Self::stable_step_3d(kin, penalty));
+            return Some(Self::stable_step_3d(kin, penalty, shear));
         }
+        let k = (3.0 * penalty).max(shear);
         let (mut best, mut which) = (f64::INFINITY, 0);
         for (n, &m) in kin.mass.iter().enumerate() {
-            let dt = 2.0 * (m / (2.0 * 3.0 * penalty)).sqrt();
+            let dt = 2.0 * (m / (2.0 * k)).sqrt();
             if dt < best {
                 best = dt;
                 which = n;

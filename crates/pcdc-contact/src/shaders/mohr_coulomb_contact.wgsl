@@ -1,5 +1,5 @@
 // The built-in law contact-m-c: the arithmetic of `MohrCoulombContact::update`, in the
-// same order. Parameters: friction on (≠ 0), tan φ, shear penalty P_t (Pa/m), damping on
+// same order. Parameters: friction on (≠ 0), tan φ, shear penalty P_t (Pa), damping on
 // (≠ 0), transition stress T (Pa), exponent b (an integer on the GPU).
 // State: accumulated slip δ_s (m), largest trial stress, stress held there (Pa).
 var r: ContactStress;
@@ -22,7 +22,8 @@ if param(p, 3u) != 0.0 {
 r.shear = 0.0;
 if param(p, 0u) != 0.0 {
     (*state)[0] = (*state)[0] + dslip;
-    let kt = param(p, 2u) * h;
+    // eq. 59 corrected: τ = P_t |δ_s| / h.
+    let kt = param(p, 2u) / h;
     let limit = param(p, 1u) * r.normal;
     var t = kt * abs((*state)[0]);
     var sgn = Real(1.0);

@@ -8,7 +8,8 @@ let pen = min(param(p, 1u + ne + c), param(p, 1u + ne + t));
 var r: ContactStress;
 r.normal = s_try;
 (*state)[0] = (*state)[0] + dslip;
-let kt = pen * h;
+// eq. 59 corrected: τ = P_t |δ_s| / h.
+let kt = pen / h;
 let limit = tan_phi * r.normal;
 var ts = kt * abs((*state)[0]);
 var sgn = Real(1.0);
