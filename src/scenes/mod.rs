@@ -9,6 +9,7 @@ pub mod block_sliding;
 pub mod brazilian;
 pub mod direct_tension;
 pub mod file;
+pub mod fragmentation;
 pub mod kirsch;
 pub mod platen_test;
 pub mod ucs;
