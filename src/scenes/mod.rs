@@ -3,7 +3,7 @@
 //! `RESULT` line; tests run them at reduced size and assert the same tolerance.
 //!
 //! The laboratory tests [`ucs`] and [`brazilian`] share one platen-test set-up
-//! ([`platen_test`]) and can be written as TOML scene files ([`file`]); their upper
+//! ([`platen_test`]) and can be written as TOML scene files ([`file`](mod@file)); their upper
 //! bounds and memory guard are in [`limits`].
 
 pub mod block_sliding;
