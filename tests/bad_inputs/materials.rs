@@ -1,8 +1,51 @@
 //! Linear elasticity: constructors, setters and deserialisation share one check.
 
-use pcdc_mech::LinearElastic;
+use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_mech::{ConstitutiveModel, LinearElastic, Mechanics, Sym6};
+use pcdc_mesh::{builders, Range};
 
 use crate::{case, run};
+
+/// A plugin model that reports whatever it is given.
+#[derive(Debug)]
+struct Plugin {
+    density: f64,
+    modulus: f64,
+    damping: f64,
+}
+
+impl ConstitutiveModel for Plugin {
+    fn name(&self) -> &str {
+        "plugin"
+    }
+    fn density(&self) -> f64 {
+        self.density
+    }
+    fn young(&self) -> f64 {
+        self.modulus
+    }
+    fn wave_modulus(&self) -> f64 {
+        self.modulus
+    }
+    fn damp_factor(&self) -> f64 {
+        self.damping
+    }
+    fn update(&self, _: &Sym6, _: &Sym6, _: &mut Sym6, _: &mut [f64]) {}
+}
+
+/// Builds a 2D simulation with the plugin model.
+fn with_plugin(density: f64, modulus: f64, damping: f64) -> Result<(), pcdc_compute::ComputeError> {
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    let model = Plugin {
+        density,
+        modulus,
+        damping,
+    };
+    Simulation::builder(mesh, CpuBackend::new(1)?)
+        .physics(Mechanics::new().material(Range::All, model))
+        .build()
+        .map(|_| ())
+}
 
 fn json(text: &'static str) -> Result<LinearElastic, serde_json::Error> {
     serde_json::from_str(text)
@@ -69,6 +112,21 @@ fn bad_materials_are_named_errors() {
             case("json: missing density", "missing field `density`", || {
                 json(r#"{"young":30e9,"poisson":0.25}"#)
             }),
+            case(
+                "plugin: NaN density",
+                "density of material 0 (plugin) = NaN",
+                || with_plugin(f64::NAN, 1e10, 0.0),
+            ),
+            case(
+                "plugin: negative wave modulus",
+                "wave modulus of material 0 (plugin) = -1",
+                || with_plugin(2600.0, -1.0, 0.0),
+            ),
+            case(
+                "plugin: infinite damping",
+                "damping factor of material 0 (plugin) = inf",
+                || with_plugin(2600.0, 1e10, f64::INFINITY),
+            ),
         ],
     );
 }
