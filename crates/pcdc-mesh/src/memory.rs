@@ -212,6 +212,9 @@ mod tests {
         assert_eq!(memory_limit().unwrap(), 1 << 62);
         set_memory_limit(None);
         assert!(memory_limit().unwrap() < 1 << 62);
+        if std::path::Path::new("/proc/meminfo").exists() {
+            assert!(physical_memory().is_some_and(|b| b > 1 << 20));
+        }
         let bytes = mesh_bytes::<Dim2>(10.0, 10.0);
         let e = check_memory_against(1000, "size", 1e-3, "a mesh", bytes).unwrap_err();
         let msg = e.to_string();

@@ -263,3 +263,34 @@ impl Range {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(r: &Range, dim: usize) -> String {
+        r.validate(dim).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn ranges_that_select_nothing_are_refused_per_dimension() {
+        let z_only = Range::plane([0.0; 3], [0.0, 0.0, 1.0], 0.1);
+        assert!(err(&z_only, 2).contains("z-only"));
+        assert!(z_only.validate(3).is_ok());
+        // A NaN z corner only matters in 3D.
+        let nan_z = Range::cuboid([0.0, 0.0, f64::NAN], [1.0; 3]);
+        assert!(nan_z.validate(2).is_ok());
+        assert!(err(&nan_z, 3).contains("component 2"));
+        assert!(err(&Range::rect(1.0, 0.0, 0.0, 1.0), 2).contains("min[0] = 1"));
+        assert!(
+            Range::rect(0.0, 0.0, 0.0, 1.0).validate(2).is_ok(),
+            "a line box"
+        );
+        assert!(err(&Range::All, 1).contains("dimension 1"));
+        let nested = Range::All.or(Range::Ball {
+            center: [f64::NAN; 3],
+            radius: 1.0,
+        });
+        assert!(err(&nested, 2).contains("ball centre"));
+    }
+}
