@@ -52,6 +52,16 @@ fn bad_meshes_are_named_errors() {
             case("infinite coordinate", "non-finite", || {
                 m2(&[0.0, 0.0, 1.0, 0.0, 0.0, f64::INFINITY], &[0, 1, 2])
             }),
+            case(
+                "coordinate beyond 1e100 m",
+                "beyond the limit of 1e100 m",
+                || m2(&[0.0, 0.0, 1e200, 0.0, 0.0, 1.0], &[0, 1, 2]),
+            ),
+            case(
+                "builder: 1e200 m rectangle",
+                "beyond the limit of 1e100 m",
+                || builders::rectangle(0.0, 0.0, 1e200, 1e200, 1e200),
+            ),
             case("node index out of range", "refers to node 7", || {
                 m2(&SQ[..6], &[0, 1, 7])
             }),

@@ -15,6 +15,9 @@ pub enum MeshError {
     /// A node coordinate is NaN or infinite.
     #[error("node {node} has a non-finite coordinate")]
     NonFiniteCoordinate { node: usize },
+    /// A node coordinate exceeds [`crate::MAX_COORD`] in magnitude.
+    #[error("node {node} has a coordinate {value:e} m, beyond the limit of 1e100 m (element measures would overflow)")]
+    CoordinateTooLarge { node: usize, value: f64 },
     /// An element refers to a node that does not exist.
     #[error("element {element} refers to node {node}, but the mesh has {n_nodes} nodes")]
     BadNodeIndex {

@@ -72,9 +72,7 @@ pub struct MshImport<D: Dim> {
     pub merged_nodes: usize,
 }
 
-/// Largest accepted coordinate magnitude (m); larger values could overflow the element
-/// measure computations.
-const MAX_COORD: f64 = 1e100;
+use crate::MAX_COORD;
 
 /// A 2D mesh node must have `|z| <= Z_REL_TOL * (largest in-plane bounding box extent)`.
 const Z_REL_TOL: f64 = 1e-9;

@@ -39,7 +39,7 @@ mod range;
 
 pub use dim::{Dim, Dim2, Dim3, ElementKind};
 pub use error::MeshError;
-pub use mesh::{Faces, Groups, Mesh, DEGENERATE_REL, NO_NEIGHBOR};
+pub use mesh::{Faces, Groups, Mesh, DEGENERATE_REL, MAX_COORD, NO_NEIGHBOR};
 pub use range::{PointPredicate, Range};
 
 pub mod builders;

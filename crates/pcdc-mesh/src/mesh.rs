@@ -8,6 +8,11 @@ use crate::{Dim, MeshError, Range};
 /// Marker for "no neighbouring element" in [`Faces::neighbor`].
 pub const NO_NEIGHBOR: u32 = u32::MAX;
 
+/// Largest accepted coordinate magnitude (m): 1e100, far beyond any physical length
+/// (the observable universe is about 1e27 m), and small enough that element measures
+/// (products of up to three coordinate differences) cannot overflow.
+pub const MAX_COORD: f64 = 1e100;
+
 /// Relative threshold under which an element counts as degenerate: its measure is
 /// compared with `DEGENERATE_REL * (longest edge)^D`.
 pub const DEGENERATE_REL: f64 = 1e-10;
@@ -134,7 +139,8 @@ fn check_faces(stored: &Faces, built: &Faces) -> Result<(), MeshError> {
 }
 
 impl<D: Dim> Mesh<D> {
-    /// Builds a mesh and checks it: array lengths, finite coordinates, node indices,
+    /// Builds a mesh and checks it: array lengths, finite coordinates of magnitude at most
+    /// [`MAX_COORD`], node indices,
     /// repeated nodes, inverted and degenerate elements, dangling nodes, manifold faces.
     ///
     /// `coords` holds `D` values per node (m); `elements` holds `NODES_PER_ELEM` node
@@ -169,6 +175,12 @@ impl<D: Dim> Mesh<D> {
         let n_nodes = coords.len() / d;
         if let Some(i) = coords.iter().position(|v| !v.is_finite()) {
             return Err(MeshError::NonFiniteCoordinate { node: i / d });
+        }
+        if let Some(i) = coords.iter().position(|v| v.abs() > MAX_COORD) {
+            return Err(MeshError::CoordinateTooLarge {
+                node: i / d,
+                value: coords[i],
+            });
         }
         let measure_name = if d == 2 { "area" } else { "volume" };
         let mut used = vec![false; n_nodes];
