@@ -1,20 +1,29 @@
 //! Mechanical boundary conditions, checked when the simulation is built.
 
 use pcdc_compute::{CpuBackend, Simulation};
-use pcdc_mech::{Boundary, Constraint, FaceStress, LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Range};
+use pcdc_mech::{set_velocity, Boundary, Constraint, FaceStress, LinearElastic, Mechanics};
+use pcdc_mesh::{builders, Dim2, Range};
 
 use crate::{case, run};
 
-/// Builds a 2D elastic square with `bc`; `Ok(())` when the simulation builds.
-fn build(bc: Boundary) -> Result<(), pcdc_compute::ComputeError> {
+/// A 2D elastic square with `bc`.
+fn sim(bc: Boundary) -> Result<Simulation<Dim2, CpuBackend>, pcdc_compute::ComputeError> {
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
     let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
     Simulation::builder(mesh, CpuBackend::new(1)?)
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(bc)
         .build()
-        .map(|_| ())
+}
+
+/// Builds the square with `bc`; `Ok(())` when the simulation builds.
+fn build(bc: Boundary) -> Result<(), pcdc_compute::ComputeError> {
+    sim(bc).map(|_| ())
+}
+
+/// Sets an initial velocity on the square's top nodes.
+fn initial_velocity(v: [f64; 3]) -> Result<usize, pcdc_mech::MechError> {
+    set_velocity(&mut sim(Boundary::new()).unwrap(), &top(), v)
 }
 
 fn b() -> Boundary {
@@ -86,6 +95,14 @@ fn bad_boundary_conditions_are_named_errors() {
                     center: [0.0; 3],
                     radius: f64::NAN,
                 }))
+            }),
+            case(
+                "initial velocity z in 2D",
+                "velocity z component = 1",
+                || initial_velocity([0.0, 0.0, 1.0]),
+            ),
+            case("NaN initial velocity", "must be finite", || {
+                initial_velocity([f64::NAN, 0.0, 0.0])
             }),
             case("unknown group", "no node group named 'lid'", || {
                 build(b().fix(Range::group("lid")))
