@@ -100,7 +100,8 @@ fn bad_values_are_named() {
             "rock.poisson",
         ),
         (
-            "scene = \"ucs\"\n[rock]\npoisson = -0.1\n".to_string(),
+            // ν = -1 (ν < 0 is allowed for auxetic rock, but G would be infinite).
+            "scene = \"ucs\"\n[rock]\npoisson = -1.0\n".to_string(),
             "rock.poisson",
         ),
         (

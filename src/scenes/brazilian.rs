@@ -126,7 +126,7 @@ impl Params {
 
     /// Checks every value; the error names the key as written in a scene file.
     pub fn validate(&self) -> Result<(), ParamError> {
-        positive("disc.diameter", self.disc.diameter)?;
+        platen_test::dimension("disc.diameter", self.disc.diameter)?;
         positive("disc.mesh_size", self.disc.mesh_size)?;
         if self.disc.mesh_size > 0.5 * self.disc.diameter {
             return Err(ParamError {
@@ -143,6 +143,15 @@ impl Params {
             &self.loading,
             &self.output,
         )
+    }
+
+    /// Refuses a scene whose mesh (disc and platens at `disc.mesh_size`) would need more
+    /// memory than the [limit](pcdc_mesh::memory); see
+    /// [`check_scene_memory`](crate::scenes::limits::check_scene_memory).
+    pub fn check_memory(&self) -> Result<(), pcdc_mesh::MeshError> {
+        let r = 0.5 * self.disc.diameter;
+        let area = std::f64::consts::PI * r * r + 2.0 * self.platens.width * self.platens.height;
+        crate::scenes::limits::check_scene_memory("disc.mesh_size", self.disc.mesh_size, area)
     }
 }
 
@@ -201,6 +210,7 @@ pub fn run<B: Backend>(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<Outcome, SceneError> {
     p.validate()?;
+    p.check_memory()?;
     let d = p.disc.diameter;
     let specimen = builders::disc([0.0, 0.5 * d], 0.5 * d, p.disc.mesh_size)?;
     let raw = platen_test::run(

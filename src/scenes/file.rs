@@ -2,7 +2,10 @@
 //! `scenes/brazilian.toml`). The first key names the scene (`scene = "ucs"` or
 //! `scene = "brazilian"`); omitted tables and keys take the scene's full-size values
 //! (a `[loading]` or `[output]` table, when given, gives all its keys), unknown keys are errors (with the line and the accepted keys), and
-//! every value is range-checked with an error that names its key.
+//! every value is range-checked with an error that names its key: lower bounds from
+//! physics, upper bounds where a value is physically absurd for a laboratory test
+//! (documented with their reasons in [`crate::scenes::limits`]), and the memory the mesh
+//! would need against the [memory limit](pcdc_mesh::memory).
 //!
 //! ```
 //! use pcdc::scenes::file::SceneFile;
@@ -58,6 +61,10 @@ pub enum SceneFileError {
     /// A value out of range (negative size, ν ≥ 0.5, ...).
     #[error("invalid value {0}")]
     Param(#[from] ParamError),
+    /// The mesh the scene would build exceeds the memory limit (the message gives the
+    /// estimate in bytes), or the limit's environment variable is malformed.
+    #[error("{0}")]
+    Memory(#[from] pcdc_mesh::MeshError),
     /// The scene could not be written as TOML.
     #[error("cannot write the scene as TOML: {0}")]
     Write(#[from] toml::ser::Error),
@@ -77,11 +84,13 @@ impl SceneFile {
             Some("ucs") => {
                 let p: ucs::Params = toml::from_str(text)?;
                 p.validate()?;
+                p.check_memory()?;
                 SceneFile::Ucs(p)
             }
             Some("brazilian") => {
                 let p: brazilian::Params = toml::from_str(text)?;
                 p.validate()?;
+                p.check_memory()?;
                 SceneFile::Brazilian(p)
             }
             Some(other) => return Err(SceneFileError::UnknownScene(other.into())),

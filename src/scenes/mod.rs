@@ -3,7 +3,8 @@
 //! `RESULT` line; tests run them at reduced size and assert the same tolerance.
 //!
 //! The laboratory tests [`ucs`] and [`brazilian`] share one platen-test set-up
-//! ([`platen_test`]) and can be written as TOML scene files ([`file`]).
+//! ([`platen_test`]) and can be written as TOML scene files ([`file`](mod@file)); their upper
+//! bounds and memory guard are in [`limits`].
 
 pub mod block_sliding;
 pub mod brazilian;
@@ -11,6 +12,7 @@ pub mod direct_tension;
 pub mod file;
 pub mod fragmentation;
 pub mod kirsch;
+pub mod limits;
 pub mod platen_test;
 pub mod ucs;
 pub mod vibration_energy;

@@ -25,6 +25,69 @@ use pcdc_mesh::{builders, Dim2, Mesh, Range};
 
 use crate::report::SceneError;
 
+use super::limits::{
+    at_most, MAX_DENSITY, MAX_FRACTURE_ENERGY, MAX_MODULUS, MAX_PENALTY_FACTOR,
+    MAX_PLATEN_VELOCITY, MAX_RAMP_TIME, MAX_SAMPLE_SIZE, MAX_STRENGTH,
+};
+
+/// Checks Poisson's ratio: −1 < ν < 0.5 (bulk and shear moduli positive; ν < 0 is allowed
+/// for auxetic materials).
+fn poisson(key: &str, value: f64) -> Result<(), ParamError> {
+    if value > -1.0 && value < 0.5 {
+        Ok(())
+    } else {
+        Err(ParamError {
+            key: key.into(),
+            value,
+            reason: "must lie in (-1, 0.5) so that the bulk and shear moduli are positive",
+        })
+    }
+}
+
+/// Checks an elastic modulus: positive, finite and at most [`MAX_MODULUS`].
+fn modulus(key: &str, value: f64) -> Result<(), ParamError> {
+    positive(key, value)?;
+    at_most(
+        key,
+        value,
+        MAX_MODULUS,
+        "must be at most 1e13 Pa (10 TPa, ten times diamond)",
+    )
+}
+
+/// Checks a density: positive, finite and at most [`MAX_DENSITY`].
+fn density(key: &str, value: f64) -> Result<(), ParamError> {
+    positive(key, value)?;
+    at_most(
+        key,
+        value,
+        MAX_DENSITY,
+        "must be at most 1e5 kg/m³ (four times osmium)",
+    )
+}
+
+/// Checks a specimen or platen dimension: positive, finite and at most [`MAX_SAMPLE_SIZE`].
+pub(crate) fn dimension(key: &str, value: f64) -> Result<(), ParamError> {
+    positive(key, value)?;
+    at_most(
+        key,
+        value,
+        MAX_SAMPLE_SIZE,
+        "must be at most 10 m (laboratory specimens are 25-150 mm)",
+    )
+}
+
+/// Checks a penalty factor (multiple of E): positive, finite, at most [`MAX_PENALTY_FACTOR`].
+fn penalty(key: &str, value: f64) -> Result<(), ParamError> {
+    positive(key, value)?;
+    at_most(
+        key,
+        value,
+        MAX_PENALTY_FACTOR,
+        "must be at most 1e4 (times E)",
+    )
+}
+
 /// A parameter value that is out of range: names the key (as written in a scene file,
 /// e.g. `rock.poisson`), the value and what is allowed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -77,7 +140,7 @@ pub(crate) fn within(
 pub struct Rock {
     /// Young's modulus E (Pa).
     pub young: f64,
-    /// Poisson's ratio ν, in [0, 0.5).
+    /// Poisson's ratio ν, in (−1, 0.5).
     pub poisson: f64,
     /// Density ρ (kg/m³).
     pub density: f64,
@@ -100,15 +163,9 @@ impl Default for Rock {
 
 impl Rock {
     fn validate(&self, key: &str) -> Result<(), ParamError> {
-        positive(&format!("{key}.young"), self.young)?;
-        within(
-            &format!("{key}.poisson"),
-            self.poisson,
-            0.0,
-            0.5,
-            "must lie in [0, 0.5)",
-        )?;
-        positive(&format!("{key}.density"), self.density)?;
+        modulus(&format!("{key}.young"), self.young)?;
+        poisson(&format!("{key}.poisson"), self.poisson)?;
+        density(&format!("{key}.density"), self.density)?;
         within(
             &format!("{key}.damping"),
             self.damping,
@@ -156,17 +213,11 @@ impl Default for Platens {
 
 impl Platens {
     fn validate(&self) -> Result<(), ParamError> {
-        positive("platens.height", self.height)?;
-        positive("platens.width", self.width)?;
-        positive("platens.young", self.young)?;
-        within(
-            "platens.poisson",
-            self.poisson,
-            0.0,
-            0.5,
-            "must lie in [0, 0.5)",
-        )?;
-        positive("platens.density", self.density)
+        dimension("platens.height", self.height)?;
+        dimension("platens.width", self.width)?;
+        modulus("platens.young", self.young)?;
+        poisson("platens.poisson", self.poisson)?;
+        density("platens.density", self.density)
     }
 }
 
@@ -220,13 +271,20 @@ impl JointParams {
             90.0,
             "must lie in [0, 90) degrees",
         )?;
-        positive("joints.cohesion", self.cohesion)?;
-        positive("joints.tensile_strength", self.tensile_strength)?;
-        positive("joints.gf1", self.gf1)?;
-        positive("joints.gf2", self.gf2)?;
-        positive("joints.penalty_normal", self.penalty_normal)?;
-        positive("joints.penalty_shear", self.penalty_shear)?;
-        positive("joints.penalty_overlap", self.penalty_overlap)
+        for (key, v) in [
+            ("joints.cohesion", self.cohesion),
+            ("joints.tensile_strength", self.tensile_strength),
+        ] {
+            positive(key, v)?;
+            at_most(key, v, MAX_STRENGTH, "must be at most 1e10 Pa (10 GPa)")?;
+        }
+        for (key, v) in [("joints.gf1", self.gf1), ("joints.gf2", self.gf2)] {
+            positive(key, v)?;
+            at_most(key, v, MAX_FRACTURE_ENERGY, "must be at most 1e6 N/m")?;
+        }
+        penalty("joints.penalty_normal", self.penalty_normal)?;
+        penalty("joints.penalty_shear", self.penalty_shear)?;
+        penalty("joints.penalty_overlap", self.penalty_overlap)
     }
 
     /// The intrinsic CZM for a rock of Young's modulus `young` (Pa).
@@ -267,7 +325,7 @@ impl Default for ContactParams {
 
 impl ContactParams {
     fn validate(&self) -> Result<(), ParamError> {
-        positive("contact.penalty", self.penalty)?;
+        penalty("contact.penalty", self.penalty)?;
         within(
             "contact.friction_deg",
             self.friction_deg,
@@ -283,9 +341,11 @@ impl ContactParams {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Loading {
-    /// Speed of each platen towards the specimen (m/s); the platens close at twice this.
+    /// Speed of each platen towards the specimen (m/s, at most
+    /// [`MAX_PLATEN_VELOCITY`]); the platens close at twice this.
     pub platen_velocity: f64,
-    /// Time over which the platen speed ramps up linearly from zero (s): no loading shock.
+    /// Time over which the platen speed ramps up linearly from zero (s, at most
+    /// [`MAX_RAMP_TIME`]): no loading shock.
     pub ramp_time: f64,
     /// After the peak, stop once the load has fallen below this fraction of it and joints
     /// have broken, in (0, 1).
@@ -300,12 +360,24 @@ pub struct Loading {
 impl Loading {
     fn validate(&self) -> Result<(), ParamError> {
         positive("loading.platen_velocity", self.platen_velocity)?;
+        at_most(
+            "loading.platen_velocity",
+            self.platen_velocity,
+            MAX_PLATEN_VELOCITY,
+            "must be at most 10 m/s (faster is an impact, not a quasi-static test)",
+        )?;
         within(
             "loading.ramp_time",
             self.ramp_time,
             0.0,
             f64::INFINITY,
             "must be non-negative and finite",
+        )?;
+        at_most(
+            "loading.ramp_time",
+            self.ramp_time,
+            MAX_RAMP_TIME,
+            "must be at most 1 s (1e7-1e8 explicit steps)",
         )?;
         within(
             "loading.stop_fraction",

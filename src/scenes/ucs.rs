@@ -213,26 +213,32 @@ pub fn crossed_rectangle(
     Ok(pcdc_mesh::Mesh::new(coords, conn)?)
 }
 
-/// Largest number of cells the rectangle builders accept (guards the allocation).
-const MAX_CELLS: f64 = 1e8;
-
 /// Columns and rows, `ceil(width / sx)` and `ceil(height / sy)` (at least 1), of a
 /// rectangle builder; an error names the bad input instead of a panic or a huge
-/// allocation.
+/// allocation: a grid that 32-bit indices cannot number, or whose mesh would exceed the
+/// [memory limit](pcdc_mesh::memory) (the estimate in bytes is in the message).
 fn cell_counts(width: f64, height: f64, sx: f64, sy: f64) -> Result<(usize, usize), SceneError> {
     positive("width", width)?;
     positive("height", height)?;
     positive("mesh size", sx)?;
     positive("mesh size", sy)?;
     let (nx, ny) = ((width / sx).ceil().max(1.0), (height / sy).ceil().max(1.0));
-    if nx * ny > MAX_CELLS {
+    // Up to two triangles per cell, one node per cell corner and the staggered rows'.
+    let (elements, nodes) = (2.0 * nx * ny, (nx + 2.0) * (ny + 1.0));
+    if elements > u32::MAX as f64 {
         return Err(ParamError {
             key: "sample.mesh_size".into(),
             value: sx,
-            reason: "gives more than 1e8 cells",
+            reason: "gives more elements than 32-bit indices can number",
         }
         .into());
     }
+    pcdc_mesh::memory::check_mesh_memory::<pcdc_mesh::Dim2>(
+        "sample.mesh_size",
+        sx,
+        nodes,
+        elements,
+    )?;
     Ok((nx as usize, ny as usize))
 }
 
@@ -330,8 +336,8 @@ impl Params {
 
     /// Checks every value; the error names the key as written in a scene file.
     pub fn validate(&self) -> Result<(), ParamError> {
-        positive("sample.height", self.sample.height)?;
-        positive("sample.width", self.sample.width)?;
+        platen_test::dimension("sample.height", self.sample.height)?;
+        platen_test::dimension("sample.width", self.sample.width)?;
         positive("sample.mesh_size", self.sample.mesh_size)?;
         if self.sample.mesh_size > self.sample.width.min(self.sample.height) {
             return Err(ParamError {
@@ -355,6 +361,15 @@ impl Params {
             &self.loading,
             &self.output,
         )
+    }
+
+    /// Refuses a scene whose mesh (sample and platens at `sample.mesh_size`) would need
+    /// more memory than the [limit](pcdc_mesh::memory); see
+    /// [`check_scene_memory`](crate::scenes::limits::check_scene_memory).
+    pub fn check_memory(&self) -> Result<(), pcdc_mesh::MeshError> {
+        let area =
+            self.sample.width * self.sample.height + 2.0 * self.platens.width * self.platens.height;
+        crate::scenes::limits::check_scene_memory("sample.mesh_size", self.sample.mesh_size, area)
     }
 }
 
@@ -527,6 +542,7 @@ pub fn run<B: Backend>(
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<Outcome, SceneError> {
     p.validate()?;
+    p.check_memory()?;
     let (h, w) = (p.sample.height, p.sample.width);
     let specimen = match p.sample.pattern {
         MeshPattern::Equilateral => equilateral_rectangle(-0.5 * w, 0.0, w, h, p.sample.mesh_size)?,

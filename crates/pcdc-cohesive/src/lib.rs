@@ -8,6 +8,10 @@
 //! ([`split_nodes`]) that gives the elements of FDEM regions their own nodes and puts a
 //! face-joint on every interior face.
 //!
+//! The joint models ([`IntrinsicCzm`], [`MohrCoulombJoint`]) keep their parameters
+//! private behind accessors; the constructors and deserialisation share one check, so a
+//! model read from a file is validated and its cached derived constants are always built.
+//!
 //! Joints run on both backends: [`CohesiveJoints`] has a GPU kernel into which each
 //! model's WGSL body ([`JointModel::wgsl`], [`WgslJointModel`]) is spliced; the built-in
 //! models provide one, and the softening curve uses the hand-written [`portable_exp`] on

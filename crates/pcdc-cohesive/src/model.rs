@@ -255,32 +255,73 @@ pub struct WgslJointModel {
 
 /// Parameters of the intrinsic cohesive zone model (manual table 9, keyword
 /// `classic-intrinsic-cohesive-interface`).
+///
+/// The parameters are private (read them with the accessors): [`IntrinsicCzm::new`] and
+/// deserialisation share one check (strengths, energies and penalties positive and
+/// finite; 0 ≤ φ < 90°) and build the cached derived constants, which therefore can never
+/// be stale or skipped. The serialised keys are the accessor names.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "CzmParams", into = "CzmParams")]
 pub struct IntrinsicCzm {
-    /// Friction angle φ (degrees).
-    pub friction_deg: f64,
-    /// Cohesion c (Pa).
-    pub cohesion: f64,
-    /// Tensile strength T_s (Pa).
-    pub tensile_strength: f64,
-    /// Mode I fracture energy G_f1 (N/m).
-    pub gf1: f64,
-    /// Mode II fracture energy G_f2 (N/m).
-    pub gf2: f64,
-    /// Normal opening penalty P_open (Pa).
-    pub penalty_open: f64,
-    /// Shear penalty P_tan (Pa).
-    pub penalty_shear: f64,
-    /// Overlap penalty P_overlap (Pa).
-    pub penalty_overlap: f64,
+    friction_deg: f64,
+    cohesion: f64,
+    tensile_strength: f64,
+    gf1: f64,
+    gf2: f64,
+    penalty_open: f64,
+    penalty_shear: f64,
+    penalty_overlap: f64,
     /// ∫₀¹ f(D) dD, cached.
-    #[serde(skip, default = "softening_integral")]
     softening_work: f64,
     /// Constants derived from the parameters, cached so that the per-step path
-    /// evaluates one division and no trigonometry (rebuilt on the fly after
-    /// deserialisation).
-    #[serde(skip)]
+    /// evaluates one division and no trigonometry (always set by [`IntrinsicCzm::new`]).
     derived: Option<Derived>,
+}
+
+/// The serialised form of [`IntrinsicCzm`], checked by [`IntrinsicCzm::new`].
+#[derive(Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CzmParams {
+    friction_deg: f64,
+    cohesion: f64,
+    tensile_strength: f64,
+    gf1: f64,
+    gf2: f64,
+    penalty_open: f64,
+    penalty_shear: f64,
+    penalty_overlap: f64,
+}
+
+impl TryFrom<CzmParams> for IntrinsicCzm {
+    type Error = CohesiveError;
+
+    fn try_from(p: CzmParams) -> Result<Self, CohesiveError> {
+        IntrinsicCzm::new(
+            p.friction_deg,
+            p.cohesion,
+            p.tensile_strength,
+            p.gf1,
+            p.gf2,
+            p.penalty_open,
+            p.penalty_shear,
+            p.penalty_overlap,
+        )
+    }
+}
+
+impl From<IntrinsicCzm> for CzmParams {
+    fn from(m: IntrinsicCzm) -> Self {
+        CzmParams {
+            friction_deg: m.friction_deg,
+            cohesion: m.cohesion,
+            tensile_strength: m.tensile_strength,
+            gf1: m.gf1,
+            gf2: m.gf2,
+            penalty_open: m.penalty_open,
+            penalty_shear: m.penalty_shear,
+            penalty_overlap: m.penalty_overlap,
+        }
+    }
 }
 
 /// Constants of [`IntrinsicCzm`] derived once from its parameters.
@@ -364,6 +405,46 @@ impl IntrinsicCzm {
             derived: None,
         }
         .with_derived())
+    }
+
+    /// Friction angle φ (degrees).
+    pub fn friction_deg(&self) -> f64 {
+        self.friction_deg
+    }
+
+    /// Cohesion c (Pa).
+    pub fn cohesion(&self) -> f64 {
+        self.cohesion
+    }
+
+    /// Tensile strength T_s (Pa).
+    pub fn tensile_strength(&self) -> f64 {
+        self.tensile_strength
+    }
+
+    /// Mode I fracture energy G_f1 (N/m).
+    pub fn gf1(&self) -> f64 {
+        self.gf1
+    }
+
+    /// Mode II fracture energy G_f2 (N/m).
+    pub fn gf2(&self) -> f64 {
+        self.gf2
+    }
+
+    /// Normal opening penalty P_open (Pa).
+    pub fn penalty_open(&self) -> f64 {
+        self.penalty_open
+    }
+
+    /// Shear penalty P_tan (Pa).
+    pub fn penalty_shear(&self) -> f64 {
+        self.penalty_shear
+    }
+
+    /// Overlap penalty P_overlap (Pa).
+    pub fn penalty_overlap(&self) -> f64 {
+        self.penalty_overlap
     }
 
     fn with_derived(mut self) -> Self {
@@ -535,16 +616,50 @@ impl JointModel for IntrinsicCzm {
 /// residual cohesion, often zero). Shear acts only while the faces touch. The state
 /// holds the plastic slip vector (global components), so reversed sliding unloads
 /// elastically; large rotations of a sliding joint are not followed by that vector.
+///
+/// The parameters are private (read them with the accessors); [`MohrCoulombJoint::new`]
+/// and deserialisation share one check.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "MohrCoulombParams", into = "MohrCoulombParams")]
 pub struct MohrCoulombJoint {
-    /// Friction angle φ (degrees).
-    pub friction_deg: f64,
-    /// Residual cohesion c_r (Pa), ≥ 0.
-    pub cohesion: f64,
-    /// Normal (overlap) penalty P_n (Pa).
-    pub penalty_normal: f64,
-    /// Shear penalty P_t (Pa).
-    pub penalty_shear: f64,
+    friction_deg: f64,
+    cohesion: f64,
+    penalty_normal: f64,
+    penalty_shear: f64,
+}
+
+/// The serialised form of [`MohrCoulombJoint`], checked by [`MohrCoulombJoint::new`].
+#[derive(Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MohrCoulombParams {
+    friction_deg: f64,
+    cohesion: f64,
+    penalty_normal: f64,
+    penalty_shear: f64,
+}
+
+impl TryFrom<MohrCoulombParams> for MohrCoulombJoint {
+    type Error = CohesiveError;
+
+    fn try_from(p: MohrCoulombParams) -> Result<Self, CohesiveError> {
+        MohrCoulombJoint::new(
+            p.friction_deg,
+            p.cohesion,
+            p.penalty_normal,
+            p.penalty_shear,
+        )
+    }
+}
+
+impl From<MohrCoulombJoint> for MohrCoulombParams {
+    fn from(m: MohrCoulombJoint) -> Self {
+        MohrCoulombParams {
+            friction_deg: m.friction_deg,
+            cohesion: m.cohesion,
+            penalty_normal: m.penalty_normal,
+            penalty_shear: m.penalty_shear,
+        }
+    }
 }
 
 impl MohrCoulombJoint {
@@ -587,6 +702,26 @@ impl MohrCoulombJoint {
             penalty_normal,
             penalty_shear,
         })
+    }
+
+    /// Friction angle φ (degrees).
+    pub fn friction_deg(&self) -> f64 {
+        self.friction_deg
+    }
+
+    /// Residual cohesion c_r (Pa).
+    pub fn cohesion(&self) -> f64 {
+        self.cohesion
+    }
+
+    /// Normal (overlap) penalty P_n (Pa).
+    pub fn penalty_normal(&self) -> f64 {
+        self.penalty_normal
+    }
+
+    /// Shear penalty P_t (Pa).
+    pub fn penalty_shear(&self) -> f64 {
+        self.penalty_shear
     }
 }
 

@@ -6,10 +6,37 @@ use serde::{Deserialize, Serialize};
 use crate::ComputeError;
 
 /// A piecewise-linear table `value(t)` through sorted points; constant beyond its ends.
+///
+/// Its points are private: [`Table::new`] and deserialisation share one check (at least
+/// one point, finite entries, strictly increasing times, as many times as values), so a
+/// table from a file can neither panic when evaluated nor run silently out of order.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawTable")]
 pub struct Table {
     t: Vec<f64>,
     v: Vec<f64>,
+}
+
+/// The serialised form of a [`Table`] (times in s, values), checked before it becomes one.
+#[derive(Deserialize)]
+struct RawTable {
+    t: Vec<f64>,
+    v: Vec<f64>,
+}
+
+impl TryFrom<RawTable> for Table {
+    type Error = ComputeError;
+
+    fn try_from(raw: RawTable) -> Result<Self, ComputeError> {
+        if raw.t.len() != raw.v.len() {
+            return Err(ComputeError::InvalidTable {
+                name: "(deserialised)".into(),
+                reason: format!("{} times (t) but {} values (v)", raw.t.len(), raw.v.len()),
+            });
+        }
+        let points: Vec<(f64, f64)> = raw.t.into_iter().zip(raw.v).collect();
+        Table::new("(deserialised)", &points)
+    }
 }
 
 impl Table {
@@ -118,6 +145,20 @@ mod tests {
         assert!(e.to_string().contains("entry 2"), "{e}");
         assert!(Table::new("v", &[(0.0, f64::NAN)]).is_err());
         assert!(Table::new("v", &[(0.0, 1.0), (0.0, 2.0)]).is_err());
+    }
+
+    #[test]
+    fn deserialisation_is_checked_like_new() {
+        let ok: Table = serde_json::from_str(r#"{"t":[0.0,1.0],"v":[0.0,2.0]}"#).unwrap();
+        assert_eq!(ok.eval(0.5), 1.0);
+        for (json, what) in [
+            (r#"{"t":[],"v":[]}"#, "empty"),
+            (r#"{"t":[1.0,0.0],"v":[0.0,2.0]}"#, "entry 1"),
+            (r#"{"t":[0.0,1.0],"v":[0.0]}"#, "2 times (t) but 1 values"),
+        ] {
+            let e = serde_json::from_str::<Table>(json).unwrap_err().to_string();
+            assert!(e.contains(what), "{json}: {e}");
+        }
     }
 
     #[test]

@@ -9,7 +9,8 @@ use crate::MechError;
 /// Name of the node field that stores the displacement at the last reset.
 pub const DISPLACEMENT_RESET: &str = "displacement_reset";
 
-/// Sets the velocity (m/s) of every node in `range` (first `D` components used).
+/// Sets the velocity (m/s) of every node in `range` (first `D` components used; on a 2D
+/// mesh a non-zero z component is an error, as it would be ignored).
 pub fn set_velocity<D: Dim, B: Backend>(
     sim: &mut Simulation<D, B>,
     range: &Range,
@@ -22,8 +23,15 @@ pub fn set_velocity<D: Dim, B: Backend>(
             "must be finite",
         ));
     }
-    let nodes = sim.mesh().select_nodes(range)?;
     let d = D::D;
+    if d == 2 && velocity[2] != 0.0 {
+        return Err(MechError::param(
+            "velocity z component",
+            velocity[2],
+            "is non-zero, but the mesh is 2D",
+        ));
+    }
+    let nodes = sim.mesh().select_nodes(range)?;
     for &n in &nodes {
         sim.state.v[n as usize * d..(n as usize + 1) * d].copy_from_slice(&velocity[..d]);
     }

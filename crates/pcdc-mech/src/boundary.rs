@@ -113,9 +113,24 @@ pub struct Boundary {
     accel_field: Option<FieldId>,
 }
 
-fn check(values: &Components, what: &str) -> Result<(), MechError> {
+/// Whether a z value prescribed on a 2D mesh would be ignored silently (anything but the
+/// constant 0, which ignoring does not change).
+fn ignored_in_2d(v: &TimeValue) -> bool {
+    !matches!(v, TimeValue::Const(c) if *c == 0.0)
+}
+
+/// Checks prescribed components: constants finite, and no z component (index 2) other
+/// than the constant 0 in 2D, where it would be silently ignored.
+fn check(values: &Components, what: &str, dim: usize) -> Result<(), MechError> {
     for (k, v) in values.iter().enumerate() {
         if let Some(v) = v {
+            if k >= dim && ignored_in_2d(v) {
+                return Err(MechError::param(
+                    format!("{what} component {k} (z)"),
+                    format!("{v:?}"),
+                    format!("is prescribed, but the mesh is {dim}D: leave it None"),
+                ));
+            }
             v.check(&format!("{what} component {k}"))?;
         }
     }
@@ -163,13 +178,24 @@ impl Boundary {
         self.constraint(range, Constraint::Fixed)
     }
 
-    fn validate(&self) -> Result<(), MechError> {
+    /// Checks every item for a mesh of dimension `dim` (called when the simulation is
+    /// built): constants finite (tables check themselves), no z component or σ_zz in 2D
+    /// (other than the constant 0, which changes nothing), constraint directions finite
+    /// and non-zero in the mesh's dimension (a z-only direction is an error in 2D).
+    fn validate(&self, dim: usize) -> Result<(), MechError> {
         for it in &self.items {
             match it {
-                Item::Velocity { values, .. } => check(values, "velocity")?,
-                Item::Acceleration { values, .. } => check(values, "acceleration")?,
-                Item::NodeForce { values, .. } => check(values, "node force")?,
+                Item::Velocity { values, .. } => check(values, "velocity", dim)?,
+                Item::Acceleration { values, .. } => check(values, "acceleration", dim)?,
+                Item::NodeForce { values, .. } => check(values, "node force", dim)?,
                 Item::FaceStress { stress, .. } => {
+                    if let (2, Some(zz)) = (dim, stress.zz.as_ref().filter(|v| ignored_in_2d(v))) {
+                        return Err(MechError::param(
+                            "face stress zz",
+                            format!("{zz:?}"),
+                            "is prescribed, but the mesh is 2D: leave it None",
+                        ));
+                    }
                     for (n, v) in [
                         ("xx", &stress.xx),
                         ("yy", &stress.yy),
@@ -184,11 +210,13 @@ impl Boundary {
                 Item::Constraint { constraint, .. } => match constraint {
                     Constraint::Fixed => {}
                     Constraint::Line(d) | Constraint::Plane(d) => {
-                        if d.iter().any(|x| !x.is_finite()) || d.iter().all(|x| *x == 0.0) {
+                        if d.iter().any(|x| !x.is_finite()) || d[..dim].iter().all(|x| *x == 0.0) {
                             return Err(MechError::param(
                                 "constraint direction",
                                 format!("{d:?}"),
-                                "must be finite and non-zero",
+                                format!(
+                                    "must be finite and non-zero in its first {dim} components"
+                                ),
                             ));
                         }
                     }
@@ -262,7 +290,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
-        self.validate()?;
+        self.validate(D::D)?;
         let mesh = ctx.mesh;
         self.resolved.clear();
         self.accel_field = ctx.fields.id(ACCEL_VELOCITY).ok();
@@ -586,19 +614,21 @@ mod tests {
             .into()
     }
 
-    /// A boundary with every kind of item (tables and constants, partial components).
-    fn every_item(sides: [&str; 4]) -> Boundary {
+    /// A boundary with every kind of item (tables and constants, partial components); z
+    /// components and σ_zz only in 3D, where they are allowed.
+    fn every_item(sides: [&str; 4], dim: usize) -> Boundary {
         let [a, b, c, e] = sides.map(Range::group);
+        let z = |v: f64| (dim == 3).then(|| TimeValue::from(v));
         Boundary::new()
-            .velocity(a.clone(), [None, Some(ramp()), Some(0.5.into())])
-            .acceleration(b.clone(), [Some(ramp()), None, Some(1.0.into())])
+            .velocity(a.clone(), [None, Some(ramp()), z(0.5)])
+            .acceleration(b.clone(), [Some(ramp()), None, z(1.0)])
             .node_force(c.clone(), [Some(1.0.into()), Some(ramp()), None])
             .face_stress(
                 e.clone(),
                 FaceStress {
                     xx: Some(ramp()),
                     yy: Some((-2.0).into()),
-                    zz: Some(3.0.into()),
+                    zz: z(3.0),
                     normal: Some(ramp()),
                 },
             )
@@ -641,8 +671,8 @@ mod tests {
     #[test]
     fn gpu_kernels_validate_with_naga_2d_and_3d() {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.25).unwrap();
-        check_sources(&m2, every_item(["top", "left", "right", "bottom"]));
+        check_sources(&m2, every_item(["top", "left", "right", "bottom"], 2));
         let m3 = builders::cuboid([0.0; 3], [1.0, 0.5, 0.5], 0.5).unwrap();
-        check_sources(&m3, every_item(["zmax", "xmin", "xmax", "ymin"]));
+        check_sources(&m3, every_item(["zmax", "xmin", "xmax", "ymin"], 3));
     }
 }

@@ -7,6 +7,15 @@
 //! (velocities, accelerations, forces, face stresses, move constraints), initial stress,
 //! and the resets of 7.2.8.
 //!
+//! ## Input checks
+//!
+//! [`LinearElastic`] keeps its parameters private and checks them in its constructors,
+//! setters and deserialisation alike (E, ρ positive and finite; −1 < ν < 0.5, i.e. bulk
+//! and shear moduli positive, auxetic ν < 0 allowed; D_f ≥ 0). [`Boundary`] checks its
+//! items when the simulation is built: finite constants, constraint directions non-zero
+//! in the mesh's dimension, and no z component or σ_zz prescribed on a 2D mesh (it would
+//! be ignored silently; the constant 0 is accepted, as ignoring it changes nothing). Errors name the parameter and its value.
+//!
 //! ## Equations implemented
 //!
 //! | manual | what | where |

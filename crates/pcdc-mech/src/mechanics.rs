@@ -140,6 +140,7 @@ impl Mechanics {
                     entity: "element",
                 });
             }
+            check_model(i, model.as_ref())?;
             for e in sel {
                 material[e as usize] = i as u16;
             }
@@ -832,6 +833,29 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
             })
             .sum()
     }
+}
+
+/// Checks what the integrator takes from a constitutive model (a plugin may report
+/// anything): density and P-wave modulus positive and finite, damping factor
+/// non-negative and finite. The error names the material and its model.
+fn check_model(i: usize, model: &dyn ConstitutiveModel) -> Result<(), MechError> {
+    let checks = [
+        ("density", model.density(), false),
+        ("wave modulus", model.wave_modulus(), false),
+        ("damping factor", model.damp_factor(), true),
+    ];
+    for (what, v, zero_ok) in checks {
+        let ok = v.is_finite() && (v > 0.0 || (zero_ok && v == 0.0));
+        if !ok {
+            let sign = if zero_ok { "non-negative" } else { "positive" };
+            return Err(MechError::param(
+                format!("{what} of material {i} ({})", model.name()),
+                v,
+                format!("must be {sign} and finite"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

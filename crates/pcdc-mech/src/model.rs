@@ -84,24 +84,55 @@ pub struct WgslModel {
 
 /// Isotropic linear elasticity (manual eq. 20-24), updated incrementally
 /// `σ += λ tr(Δε) I + 2μ Δε` so that initial stresses superpose.
+///
+/// The parameters are private: the constructors, the `with_*` setters and deserialisation
+/// share one check, so a model from a file or a struct update cannot bypass it. Checked:
+/// E > 0 and finite (Pa); −1 < ν < 0.5, i.e. bulk modulus K and shear modulus G positive
+/// (ν < 0 is allowed: auxetic materials exist; ν = 0.5 is incompressible, which explicit
+/// elements cannot represent); ρ > 0 and finite (kg/m³); D_f ≥ 0 and finite; friction
+/// angle in [0, 90) degrees; contact penalty, when given, > 0 and finite (Pa). Errors name
+/// the parameter (with the serialised key, e.g. `poisson`) and its value.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawLinearElastic")]
 pub struct LinearElastic {
-    /// Young's modulus E (Pa).
-    pub young: f64,
-    /// Poisson's ratio ν (-), 0 ≤ ν < 0.5.
-    pub poisson: f64,
-    /// Density ρ (kg/m³).
-    pub density: f64,
-    /// Damping factor D_f (eq. 19), default 0 (undamped).
-    pub damp_factor: f64,
-    /// Friction angle of the surfaces for contact without a contact law (degrees, table 1
-    /// keyword `friction`), default 0.
+    young: f64,
+    poisson: f64,
+    density: f64,
+    damp_factor: f64,
+    friction: f64,
+    contact_penalty: Option<f64>,
+}
+
+/// The serialised form of [`LinearElastic`] (same keys), checked before it becomes one.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLinearElastic {
+    young: f64,
+    poisson: f64,
+    density: f64,
     #[serde(default)]
-    pub friction: f64,
-    /// Contact penalty of the surfaces (Pa, table 1 keyword `penalty`); `None` means the
-    /// manual's default 10 E.
+    damp_factor: f64,
     #[serde(default)]
-    pub contact_penalty: Option<f64>,
+    friction: f64,
+    #[serde(default)]
+    contact_penalty: Option<f64>,
+}
+
+impl TryFrom<RawLinearElastic> for LinearElastic {
+    type Error = MechError;
+
+    fn try_from(r: RawLinearElastic) -> Result<Self, MechError> {
+        let m = LinearElastic {
+            young: r.young,
+            poisson: r.poisson,
+            density: r.density,
+            damp_factor: r.damp_factor,
+            friction: r.friction,
+            contact_penalty: r.contact_penalty,
+        };
+        m.check()?;
+        Ok(m)
+    }
 }
 
 impl LinearElastic {
@@ -161,10 +192,41 @@ impl LinearElastic {
         Ok(self)
     }
 
+    /// Young's modulus E (Pa).
+    pub fn young(&self) -> f64 {
+        self.young
+    }
+
+    /// Poisson's ratio ν (-), in (−1, 0.5).
+    pub fn poisson(&self) -> f64 {
+        self.poisson
+    }
+
+    /// Density ρ (kg/m³).
+    pub fn density(&self) -> f64 {
+        self.density
+    }
+
+    /// Damping factor D_f of eq. 19 (-).
+    pub fn damp_factor(&self) -> f64 {
+        self.damp_factor
+    }
+
+    /// Friction angle of the surfaces for contact without a contact law (degrees).
+    pub fn friction(&self) -> f64 {
+        self.friction
+    }
+
+    /// The contact penalty set with [`Self::with_contact`] (Pa), or `None` for the
+    /// default 10 E (see [`ConstitutiveModel::contact_penalty`]).
+    pub fn contact_penalty_override(&self) -> Option<f64> {
+        self.contact_penalty
+    }
+
     fn check(&self) -> Result<(), MechError> {
         if !(0.0..90.0).contains(&self.friction) {
             return Err(MechError::param(
-                "friction angle",
+                "friction angle (friction)",
                 self.friction,
                 "must lie in [0, 90) degrees",
             ));
@@ -172,7 +234,7 @@ impl LinearElastic {
         if let Some(p) = self.contact_penalty {
             if !(p > 0.0 && p.is_finite()) {
                 return Err(MechError::param(
-                    "contact penalty",
+                    "contact penalty (contact_penalty)",
                     p,
                     "must be positive and finite (Pa)",
                 ));
@@ -180,24 +242,30 @@ impl LinearElastic {
         }
         if !(self.young > 0.0 && self.young.is_finite()) {
             return Err(MechError::param(
-                "Young's modulus E",
+                "Young's modulus E (young)",
                 self.young,
                 "must be positive and finite",
             ));
         }
-        if !(0.0..0.5).contains(&self.poisson) {
-            return Err(MechError::param("Poisson's ratio ν", self.poisson, "must lie in [0, 0.5) (0.5 is incompressible, which explicit elements cannot represent)"));
+        if !(self.poisson > -1.0 && self.poisson < 0.5) {
+            return Err(MechError::param(
+                "Poisson's ratio ν (poisson)",
+                self.poisson,
+                "must lie in (-1, 0.5) so that the bulk and shear moduli are positive \
+                 (ν < 0 is allowed for auxetic materials; 0.5 is incompressible, which \
+                 explicit elements cannot represent)",
+            ));
         }
         if !(self.density > 0.0 && self.density.is_finite()) {
             return Err(MechError::param(
-                "density ρ",
+                "density ρ (density)",
                 self.density,
                 "must be positive and finite",
             ));
         }
         if !(self.damp_factor >= 0.0 && self.damp_factor.is_finite()) {
             return Err(MechError::param(
-                "damping factor D_f",
+                "damping factor D_f (damp_factor)",
                 self.damp_factor,
                 "must be non-negative and finite",
             ));

@@ -11,14 +11,17 @@
 //! circle). Circular meshes are built from concentric node loops "stitched" into bands of
 //! triangles; the cylinder extrudes the disc and splits each prism into three tetrahedra.
 //!
-//! A size so small that the mesh would exceed 10⁸ elements is rejected as invalid.
+//! A size so small that the mesh could not be numbered with 32-bit indices is rejected as
+//! [`MeshError::InvalidParameter`]; one whose estimated memory exceeds the
+//! [memory limit](crate::memory) (by default half the machine's memory) is rejected as
+//! [`MeshError::MemoryLimit`], with the estimate in bytes, before anything is allocated.
 
 use std::f64::consts::{PI, TAU};
 
 use crate::{Dim, Dim2, Dim3, Mesh, MeshError};
 
-/// Largest number of elements a builder will produce.
-const MAX_ELEMENTS: f64 = 1e8;
+/// Largest number of elements 32-bit indices can number.
+const MAX_ELEMENTS: f64 = u32::MAX as f64;
 
 /// A named boundary: its nodes, from which its boundary faces are found.
 type Boundary = (&'static str, Vec<u32>);
@@ -59,17 +62,19 @@ fn at_most(name: &'static str, v: f64, limit: f64, reason: &'static str) -> Resu
     }
 }
 
-/// Rejects a size that would give more than [`MAX_ELEMENTS`] elements (`count` is an estimate).
-fn check_count(name: &'static str, size: f64, count: f64) -> Result<(), MeshError> {
-    if count <= MAX_ELEMENTS {
-        Ok(())
-    } else {
-        Err(invalid(
+/// Rejects a size that would give a mesh of `count` elements (an estimate) of dimension
+/// `D` that 32-bit indices cannot number, or whose memory estimate
+/// ([`crate::memory::mesh_bytes`], with as many nodes as elements, an upper bound) exceeds
+/// the [memory limit](crate::memory).
+fn check_count<D: Dim>(name: &'static str, size: f64, count: f64) -> Result<(), MeshError> {
+    if count.is_nan() || count > MAX_ELEMENTS {
+        return Err(invalid(
             name,
             size,
-            "too small: the mesh would exceed 1e8 elements",
-        ))
+            "too small: the mesh would exceed 2^32 - 1 elements, the limit of 32-bit indices",
+        ));
     }
+    crate::memory::check_mesh_memory::<D>(name, size, count, count)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -337,7 +342,7 @@ fn limit_growth(prev: f64, n: f64) -> f64 {
 /// with about `2π k` nodes on circle `k`. Returns it with the boundary loop.
 fn disc_planar(center: [f64; 2], radius: f64, size: f64) -> Result<(Planar, Vec<u32>), MeshError> {
     let nr = (radius / size).ceil();
-    check_count("size", size, 7.0 * nr * nr)?;
+    check_count::<Dim2>("size", size, 7.0 * nr * nr)?;
     let nr = nr as usize;
     let mut p = Planar::default();
     let c = p.node(center);
@@ -383,7 +388,7 @@ pub fn rectangle(
         "must not exceed the larger of width and height",
     )?;
     let (nx, ny) = ((width / size).ceil(), (height / size).ceil());
-    check_count("size", size, 2.0 * nx * ny)?;
+    check_count::<Dim2>("size", size, 2.0 * nx * ny)?;
     let (nx, ny) = (nx as usize, ny as usize);
     let p = Planar::grid(nx, ny, |i, j| {
         [
@@ -446,7 +451,7 @@ pub fn ring(
         "must not exceed the ring thickness r_out - r_in",
     )?;
     let grading = Grading::new(thickness, size_in, size_out);
-    check_count("size_in", size_in, 16.0 * grading.count())?;
+    check_count::<Dim2>("size_in", size_in, 16.0 * grading.count())?;
     let levels = grading.levels();
     let mut counts: Vec<f64> = (levels.iter())
         .map(|&t| {
@@ -458,7 +463,7 @@ pub fn ring(
     for k in 1..counts.len() {
         counts[k] = limit_growth(counts[k - 1], counts[k]);
     }
-    check_count("size_in", size_in, 2.0 * counts.iter().sum::<f64>())?;
+    check_count::<Dim2>("size_in", size_in, 2.0 * counts.iter().sum::<f64>())?;
     let mut p = Planar::default();
     let loops: Vec<Loop> = (levels.iter().zip(&counts))
         .map(|(&t, &n)| p.add_loop(circle(center, lerp(r_in, r_out, t), n as usize)))
@@ -544,7 +549,7 @@ pub fn plate_with_hole(
     // distances of the square core, balancing the stretch between its sides and corners.
     let len = ((a - radius) * (a * 2f64.sqrt() - radius)).sqrt();
     let grading = Grading::new(len, size_hole, size_outer);
-    check_count("size_hole", size_hole, 16.0 * grading.count())?;
+    check_count::<Dim2>("size_hole", size_hole, 16.0 * grading.count())?;
     let levels = grading.levels();
     let mut counts: Vec<f64> = (levels.iter())
         .map(|&t| {
@@ -564,7 +569,7 @@ pub fn plate_with_hole(
         (wing * n_side / (2.0 * a)).ceil()
     };
     let estimate = 8.0 * counts.iter().sum::<f64>() + 4.0 * wing_cols * n_side;
-    check_count("size_outer", size_outer, estimate)?;
+    check_count::<Dim2>("size_outer", size_outer, estimate)?;
 
     // Core [-ex, ex] x [-ey, ey]: sector q runs from corner q to corner q+1 (right, top,
     // left, bottom side) and from angle hole[q] to hole[q+1] on the hole.
@@ -705,7 +710,7 @@ pub fn dog_bone(
         (y_break, height / 2.0),
     ];
     let rows = segments.map(|(a, b)| ((b - a) / size).ceil());
-    check_count("size", size, 2.0 * nx * rows.iter().sum::<f64>())?;
+    check_count::<Dim2>("size", size, 2.0 * nx * rows.iter().sum::<f64>())?;
 
     let nx = nx as usize;
     let mut ys = vec![-height / 2.0];
@@ -774,7 +779,7 @@ pub fn cuboid(origin: [f64; 3], size_xyz: [f64; 3], size: f64) -> Result<Mesh<Di
     let largest = size_xyz.iter().copied().fold(0.0, f64::max);
     at_most("size", size, largest, "must not exceed the largest side")?;
     let nf = size_xyz.map(|l| (l / size).ceil());
-    check_count("size", size, 6.0 * nf[0] * nf[1] * nf[2])?;
+    check_count::<Dim3>("size", size, 6.0 * nf[0] * nf[1] * nf[2])?;
     let n = nf.map(|v| v as usize);
     let idx = |i: usize, j: usize, k: usize| ((k * (n[1] + 1) + j) * (n[0] + 1) + i) as u32;
 
@@ -856,7 +861,7 @@ pub fn cylinder(radius: f64, height: f64, size: f64) -> Result<Mesh<Dim3>, MeshE
     at_most("size", size, radius, "must not exceed radius")?;
     let (disc, rim) = disc_planar([0.0, 0.0], radius, size)?;
     let nzf = (height / size).ceil();
-    check_count("size", size, 3.0 * nzf * (disc.tris.len() / 3) as f64)?;
+    check_count::<Dim3>("size", size, 3.0 * nzf * (disc.tris.len() / 3) as f64)?;
     let (nz, n2) = (nzf as usize, disc.xy.len() / 2);
 
     let mut coords = Vec::with_capacity(3 * n2 * (nz + 1));

@@ -1,5 +1,7 @@
 //! Mesh errors: every variant names the offending entity or input line.
 
+const GIB: f64 = (1u64 << 30) as f64;
+
 /// Errors raised while building, importing, selecting on or writing a mesh.
 #[derive(Debug, thiserror::Error)]
 #[allow(missing_docs)] // variant fields are named after what they hold; variants are documented
@@ -13,6 +15,9 @@ pub enum MeshError {
     /// A node coordinate is NaN or infinite.
     #[error("node {node} has a non-finite coordinate")]
     NonFiniteCoordinate { node: usize },
+    /// A node coordinate exceeds [`crate::MAX_COORD`] in magnitude.
+    #[error("node {node} has a coordinate {value:e} m, beyond the limit of 1e100 m (element measures would overflow)")]
+    CoordinateTooLarge { node: usize, value: f64 },
     /// An element refers to a node that does not exist.
     #[error("element {element} refers to node {node}, but the mesh has {n_nodes} nodes")]
     BadNodeIndex {
@@ -65,6 +70,21 @@ pub enum MeshError {
         value: f64,
         reason: &'static str,
     },
+    /// A request would need more memory than the limit of [`crate::memory`].
+    #[error("{name} = {value}: {what} would need about {estimate:.3e} bytes ({:.2} GiB), above the memory limit of {limit} bytes ({:.2} GiB); ask for less, or raise the limit with pcdc_mesh::memory::set_memory_limit or the PCDC_MEMORY_LIMIT environment variable", estimate / GIB, *limit as f64 / GIB)]
+    MemoryLimit {
+        name: String,
+        value: f64,
+        what: String,
+        estimate: f64,
+        limit: u64,
+    },
+    /// The memory limit environment variable is malformed.
+    #[error("environment variable PCDC_MEMORY_LIMIT = '{value}': {reason}")]
+    MemoryLimitSetting { value: String, reason: &'static str },
+    /// A serialised mesh is inconsistent with its own elements.
+    #[error("inconsistent mesh data: {0}")]
+    Inconsistent(String),
     /// A range is ill-formed (e.g. zero plane normal).
     #[error("invalid range: {0}")]
     InvalidRange(String),

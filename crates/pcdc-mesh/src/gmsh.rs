@@ -29,6 +29,16 @@
 //!   Node groups of the same name from different dimensions are merged. Lower-dimensional
 //!   elements that belong to no physical group are ignored, whatever their type.
 //!
+//! * **Encoding.** The text is UTF-8; a leading byte-order mark (as some Windows editors
+//!   write) is skipped.
+//! * **Coincident nodes.** Nodes used by elements that lie at the same position (within
+//!   [`COINCIDENT_REL_TOL`] times the largest bounding-box extent) are not merged by
+//!   default: the elements on either side then share no face and the mesh is cut there,
+//!   which is what unmerged Gmsh surfaces or volumes give. [`parse_msh_with`] and
+//!   [`read_msh_with`] return an [`ImportWarning::CoincidentNodes`] for them, or merge them
+//!   into the node of lowest tag with [`ImportOptions::merge_coincident`];
+//!   [`read_msh`] and [`parse_msh`] print the warnings to standard error.
+//!
 //! Every malformed or truncated input gives a [`MeshError::Parse`] with the 1-based line
 //! number (the last line of the file for an unexpected end of file) and a message; the
 //! parser never panics on bad input.
@@ -47,9 +57,22 @@ use std::str::FromStr;
 
 use crate::{Dim, Mesh, MeshError};
 
-/// Largest accepted coordinate magnitude (m); larger values could overflow the element
-/// measure computations.
-const MAX_COORD: f64 = 1e100;
+mod coincident;
+pub use coincident::{ImportOptions, ImportWarning, COINCIDENT_REL_TOL};
+
+/// The result of [`parse_msh_with`] and [`read_msh_with`].
+#[derive(Clone, Debug)]
+pub struct MshImport<D: Dim> {
+    /// The mesh.
+    pub mesh: Mesh<D>,
+    /// What the import accepted but is probably not what the file meant.
+    pub warnings: Vec<ImportWarning>,
+    /// Number of nodes merged into a coincident node of lower tag
+    /// ([`ImportOptions::merge_coincident`]).
+    pub merged_nodes: usize,
+}
+
+use crate::MAX_COORD;
 
 /// A 2D mesh node must have `|z| <= Z_REL_TOL * (largest in-plane bounding box extent)`.
 const Z_REL_TOL: f64 = 1e-9;
@@ -68,6 +91,27 @@ const EXPORT_HINT: &str =
 /// and line) if its content is not a valid MSH 4.1 ASCII mesh of dimension `D` or the
 /// resulting mesh fails the checks of [`Mesh::new_reoriented`].
 pub fn read_msh<D: Dim>(path: impl AsRef<Path>) -> Result<Mesh<D>, MeshError> {
+    let import = read_msh_with::<D>(path.as_ref(), &ImportOptions::default())?;
+    Ok(print_warnings(import, &path.as_ref().display().to_string()))
+}
+
+/// Prints the warnings of an import to standard error and returns its mesh.
+fn print_warnings<D: Dim>(import: MshImport<D>, file: &str) -> Mesh<D> {
+    for w in &import.warnings {
+        eprintln!("warning: {file}: {w}");
+    }
+    import.mesh
+}
+
+/// [`read_msh`] with options, returning the warnings instead of printing them.
+///
+/// # Errors
+///
+/// As [`read_msh`], and [`MeshError::InvalidParameter`] for invalid options.
+pub fn read_msh_with<D: Dim>(
+    path: impl AsRef<Path>,
+    options: &ImportOptions,
+) -> Result<MshImport<D>, MeshError> {
     let path = path.as_ref();
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
@@ -77,7 +121,7 @@ pub fn read_msh<D: Dim>(path: impl AsRef<Path>) -> Result<Mesh<D>, MeshError> {
     // A binary file is not UTF-8; decoding it lossily still lets the header be checked
     // and rejected with a helpful message.
     let text = String::from_utf8_lossy(&bytes);
-    parse_msh(&text, &name)
+    parse_msh_with(&text, &name, options)
 }
 
 /// Parses the text of a Gmsh MSH 4.1 ASCII file into a mesh of dimension `D`.
@@ -89,8 +133,32 @@ pub fn read_msh<D: Dim>(path: impl AsRef<Path>) -> Result<Mesh<D>, MeshError> {
 /// [`MeshError::Parse`] with the 1-based line number and a message for every malformed,
 /// truncated or unsupported input.
 pub fn parse_msh<D: Dim>(text: &str, file_name: &str) -> Result<Mesh<D>, MeshError> {
+    let import = parse_msh_with::<D>(text, file_name, &ImportOptions::default())?;
+    Ok(print_warnings(import, file_name))
+}
+
+/// [`parse_msh`] with options, returning the warnings instead of printing them.
+///
+/// # Errors
+///
+/// As [`parse_msh`], and [`MeshError::InvalidParameter`] naming `coincident_rel_tol` when
+/// it is not finite or outside `[0, 1e-3]`.
+pub fn parse_msh_with<D: Dim>(
+    text: &str,
+    file_name: &str,
+    options: &ImportOptions,
+) -> Result<MshImport<D>, MeshError> {
+    let tol = options.coincident_rel_tol;
+    if !(0.0..=1e-3).contains(&tol) {
+        return Err(MeshError::InvalidParameter {
+            name: "coincident_rel_tol",
+            value: tol,
+            reason: "must be finite and in [0, 1e-3] (relative to the mesh extent)",
+        });
+    }
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let raw = parse_raw(text, file_name, D::D)?;
-    build_mesh::<D>(raw, file_name)
+    build_mesh::<D>(raw, file_name, options)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -793,7 +861,11 @@ fn parse_elements(
 // Mesh and groups
 // ---------------------------------------------------------------------------------------
 
-fn build_mesh<D: Dim>(raw: RawMsh, file: &str) -> Result<Mesh<D>, MeshError> {
+fn build_mesh<D: Dim>(
+    raw: RawMsh,
+    file: &str,
+    options: &ImportOptions,
+) -> Result<MshImport<D>, MeshError> {
     let (d, npe) = (D::D, D::NODES_PER_ELEM);
     let err = |line: usize, message: String| parse_error(file, line, message);
     let Some(elements_line) = raw.elements_line else {
@@ -851,6 +923,43 @@ fn build_mesh<D: Dim>(raw: RawMsh, file: &str) -> Result<Mesh<D>, MeshError> {
         ));
     }
 
+    // Coincident nodes: warn, or merge into the node of lowest tag.
+    let points: Vec<[f64; 3]> = nodes.iter().map(|n| n.x).collect();
+    let extent = (0..d)
+        .map(|k| {
+            let it = points
+                .iter()
+                .zip(&used)
+                .filter(|(_, &u)| u)
+                .map(|(p, _)| p[k]);
+            it.clone().fold(f64::NEG_INFINITY, f64::max) - it.fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max);
+    let tol = options.coincident_rel_tol * extent;
+    let rep = coincident::representatives(&points, &used, d, tol);
+    let mut warnings = Vec::new();
+    let dup: Vec<usize> = (0..nodes.len()).filter(|&i| rep[i] != i).collect();
+    let mut merged_nodes = 0;
+    if let Some(&first) = dup.first() {
+        if options.merge_coincident {
+            for i in conn_sorted.iter_mut() {
+                *i = rep[*i];
+            }
+            for &i in &dup {
+                used[i] = false;
+            }
+            merged_nodes = dup.len();
+        } else {
+            warnings.push(ImportWarning::CoincidentNodes {
+                count: dup.len(),
+                tags: (nodes[rep[first]].tag, nodes[first].tag),
+                position: nodes[first].x,
+                line: nodes[first].line,
+                tol,
+            });
+        }
+    }
+
     // Compact renumbering in node-tag order.
     let mut new_index = vec![u32::MAX; nodes.len()];
     let mut node_tags = Vec::new();
@@ -888,6 +997,11 @@ fn build_mesh<D: Dim>(raw: RawMsh, file: &str) -> Result<Mesh<D>, MeshError> {
                     n.tag, n.x[2]
                 ),
             ));
+        }
+    }
+    if merged_nodes > 0 {
+        for &i in &dup {
+            new_index[i] = new_index[rep[i]];
         }
     }
     let conn: Vec<u32> = conn_sorted.iter().map(|&i| new_index[i]).collect();
@@ -1029,7 +1143,11 @@ fn build_mesh<D: Dim>(raw: RawMsh, file: &str) -> Result<Mesh<D>, MeshError> {
     for (name, v) in face_groups {
         mesh.add_face_group(name, v).map_err(group_err)?;
     }
-    Ok(mesh)
+    Ok(MshImport {
+        mesh,
+        warnings,
+        merged_nodes,
+    })
 }
 
 /// Turns a mesh check failure into a parse error at the line of the offending element,
@@ -1111,6 +1229,54 @@ mod tests {
     /// Line number (1-based) of the first line equal to `l`.
     fn line_of(text: &str, l: &str) -> usize {
         text.lines().position(|x| x.trim() == l).unwrap() + 1
+    }
+
+    /// Two triangles of the unit square whose shared diagonal has duplicate nodes 5 and 6
+    /// (at the places of nodes 2 and 3): an unmerged, cut mesh.
+    pub(crate) const CUT_SQUARE: &str = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n\
+        $Nodes\n1 6 1 6\n2 1 0 6\n1\n2\n3\n4\n5\n6\n\
+        0 0 0\n1 0 0\n0 1 0\n1 1 0\n1 0 0\n0 1 0\n$EndNodes\n\
+        $Elements\n1 2 1 2\n2 1 2 2\n1 1 2 3\n2 5 4 6\n$EndElements\n";
+
+    #[test]
+    fn byte_order_mark_is_skipped() {
+        let with_bom = format!("\u{feff}{}", square_text());
+        let m = parse_msh::<Dim2>(&with_bom, "bom.msh").unwrap();
+        assert_eq!(m.n_elements(), 4);
+    }
+
+    #[test]
+    fn coincident_nodes_warn_or_merge() {
+        let opts = ImportOptions::default();
+        let cut = parse_msh_with::<Dim2>(CUT_SQUARE, "cut.msh", &opts).unwrap();
+        assert_eq!(cut.mesh.n_nodes(), 6);
+        assert_eq!(cut.mesh.faces().boundary.len(), 6, "cut: no interior face");
+        assert_eq!(cut.warnings.len(), 1);
+        let w = cut.warnings[0].to_string();
+        assert!(
+            w.contains("2 node(s) coincide") && w.contains("nodes 2 and 5"),
+            "{w}"
+        );
+        assert!(w.contains("merge_coincident"), "{w}");
+        let merged = ImportOptions {
+            merge_coincident: true,
+            ..ImportOptions::default()
+        };
+        let joined = parse_msh_with::<Dim2>(CUT_SQUARE, "cut.msh", &merged).unwrap();
+        assert!(joined.warnings.is_empty());
+        assert_eq!(joined.merged_nodes, 2);
+        assert_eq!(joined.mesh.n_nodes(), 4);
+        assert_eq!(joined.mesh.faces().len(), 5);
+        assert_eq!(joined.mesh.faces().boundary.len(), 4);
+        // A clean file gives no warning.
+        let clean = parse_msh_with::<Dim2>(&square_text(), "sq.msh", &opts).unwrap();
+        assert!(clean.warnings.is_empty());
+        let bad = ImportOptions {
+            coincident_rel_tol: f64::NAN,
+            ..ImportOptions::default()
+        };
+        let e = parse_msh_with::<Dim2>(CUT_SQUARE, "cut.msh", &bad).unwrap_err();
+        assert!(e.to_string().contains("coincident_rel_tol"), "{e}");
     }
 
     #[test]

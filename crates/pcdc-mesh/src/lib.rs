@@ -6,6 +6,27 @@
 //! and VTU/PVD output for ParaView.
 //!
 //! Units are SI throughout: coordinates in metres.
+//!
+//! ## Input checks
+//!
+//! Every way a mesh enters is checked the same way and fails with a [`MeshError`] that
+//! names the offending entity and value, never a panic: [`Mesh::new`] (array lengths,
+//! finite coordinates, node indices, repeated nodes, inverted and degenerate elements,
+//! dangling nodes, manifold faces), deserialisation of a [`Mesh`] (the same checks, plus
+//! stored faces and group indices consistent with the elements), the [`builders`]
+//! (parameters, and the memory guard below) and [`gmsh`] import (with a byte-order mark
+//! accepted and a warning, or merging, for coincident unmerged nodes).
+//! [`Range::validate`] rejects selections that cannot select anything (NaN or crossed
+//! box corners, zero or z-only normals in 2D, NaN radii and tolerances).
+//!
+//! ## Memory limit
+//!
+//! Sizes are guarded in bytes, not element counts: [`memory::mesh_bytes`] estimates a
+//! request and [`memory::check_memory`] refuses one above [`memory::memory_limit`], by
+//! default half the machine's physical memory (8 GiB assumed where `/proc/meminfo` is
+//! missing), settable with [`memory::set_memory_limit`] or the `PCDC_MEMORY_LIMIT`
+//! environment variable (bytes, optional `K`/`M`/`G`/`T` suffix). The error gives the
+//! estimate and the limit.
 
 #![warn(missing_docs)]
 // Index loops mirror the tensor notation of the manual's equations.
@@ -18,9 +39,10 @@ mod range;
 
 pub use dim::{Dim, Dim2, Dim3, ElementKind};
 pub use error::MeshError;
-pub use mesh::{Faces, Groups, Mesh, DEGENERATE_REL, NO_NEIGHBOR};
+pub use mesh::{Faces, Groups, Mesh, DEGENERATE_REL, MAX_COORD, NO_NEIGHBOR};
 pub use range::{PointPredicate, Range};
 
 pub mod builders;
 pub mod gmsh;
+pub mod memory;
 pub mod vtu;

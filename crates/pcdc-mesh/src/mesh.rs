@@ -8,6 +8,11 @@ use crate::{Dim, MeshError, Range};
 /// Marker for "no neighbouring element" in [`Faces::neighbor`].
 pub const NO_NEIGHBOR: u32 = u32::MAX;
 
+/// Largest accepted coordinate magnitude (m): 1e100, far beyond any physical length
+/// (the observable universe is about 1e27 m), and small enough that element measures
+/// (products of up to three coordinate differences) cannot overflow.
+pub const MAX_COORD: f64 = 1e100;
+
 /// Relative threshold under which an element counts as degenerate: its measure is
 /// compared with `DEGENERATE_REL * (longest edge)^D`.
 pub const DEGENERATE_REL: f64 = 1e-10;
@@ -17,7 +22,7 @@ pub const DEGENERATE_REL: f64 = 1e-10;
 /// Face `i` has nodes `nodes[i*NPF..(i+1)*NPF]`, ordered so that its normal points out of
 /// its `owner` element. `neighbor[i]` is the element on the other side, or [`NO_NEIGHBOR`]
 /// for a boundary face.
-#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Faces {
     /// Face nodes, stride `NODES_PER_FACE`, outward for the owner.
     pub nodes: Vec<u32>,
@@ -59,8 +64,13 @@ pub struct Groups {
 
 /// A mesh of one simplex element type (Tri3 in 2D, Tet4 in 3D), stored as structure of
 /// arrays: `coords` with stride `D`, `elements` with stride `NODES_PER_ELEM`, indices `u32`.
+///
+/// Deserialising a mesh runs the checks of [`Mesh::new`] on its nodes and elements,
+/// rebuilds the faces and requires the stored ones to equal them (an error names the first
+/// difference), and checks every group index as [`Mesh::add_node_group`] and its siblings
+/// do: a mesh file edited by hand or corrupted is an error, never a panic later.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-#[serde(bound = "")]
+#[serde(bound = "", try_from = "RawMesh")]
 pub struct Mesh<D: Dim> {
     coords: Vec<f64>,
     elements: Vec<u32>,
@@ -70,8 +80,67 @@ pub struct Mesh<D: Dim> {
     _dim: PhantomData<D>,
 }
 
+/// The serialised form of a [`Mesh`], checked by `TryFrom` before it becomes one.
+#[derive(serde::Deserialize)]
+struct RawMesh {
+    coords: Vec<f64>,
+    elements: Vec<u32>,
+    faces: Faces,
+    groups: Groups,
+}
+
+impl<D: Dim> TryFrom<RawMesh> for Mesh<D> {
+    type Error = MeshError;
+
+    fn try_from(raw: RawMesh) -> Result<Self, MeshError> {
+        let mut mesh = Mesh::<D>::new(raw.coords, raw.elements)?;
+        check_faces(&raw.faces, &mesh.faces)?;
+        for (name, v) in raw.groups.nodes {
+            mesh.add_node_group(name, v)?;
+        }
+        for (name, v) in raw.groups.elements {
+            mesh.add_element_group(name, v)?;
+        }
+        for (name, v) in raw.groups.faces {
+            mesh.add_face_group(name, v)?;
+        }
+        Ok(mesh)
+    }
+}
+
+/// Compares stored faces with the faces rebuilt from the elements; names the first
+/// difference.
+fn check_faces(stored: &Faces, built: &Faces) -> Result<(), MeshError> {
+    fn first_diff<T: PartialEq + std::fmt::Debug>(
+        field: &str,
+        a: &[T],
+        b: &[T],
+    ) -> Result<(), MeshError> {
+        if a.len() != b.len() {
+            return Err(MeshError::Inconsistent(format!(
+                "faces.{field} has {} entries, but the elements give {}",
+                a.len(),
+                b.len()
+            )));
+        }
+        match a.iter().zip(b).position(|(x, y)| x != y) {
+            Some(i) => Err(MeshError::Inconsistent(format!(
+                "faces.{field}[{i}] = {:?}, but the elements give {:?}",
+                a[i], b[i]
+            ))),
+            None => Ok(()),
+        }
+    }
+    first_diff("nodes", &stored.nodes, &built.nodes)?;
+    first_diff("owner", &stored.owner, &built.owner)?;
+    first_diff("owner_local", &stored.owner_local, &built.owner_local)?;
+    first_diff("neighbor", &stored.neighbor, &built.neighbor)?;
+    first_diff("boundary", &stored.boundary, &built.boundary)
+}
+
 impl<D: Dim> Mesh<D> {
-    /// Builds a mesh and checks it: array lengths, finite coordinates, node indices,
+    /// Builds a mesh and checks it: array lengths, finite coordinates of magnitude at most
+    /// [`MAX_COORD`], node indices,
     /// repeated nodes, inverted and degenerate elements, dangling nodes, manifold faces.
     ///
     /// `coords` holds `D` values per node (m); `elements` holds `NODES_PER_ELEM` node
@@ -106,6 +175,12 @@ impl<D: Dim> Mesh<D> {
         let n_nodes = coords.len() / d;
         if let Some(i) = coords.iter().position(|v| !v.is_finite()) {
             return Err(MeshError::NonFiniteCoordinate { node: i / d });
+        }
+        if let Some(i) = coords.iter().position(|v| v.abs() > MAX_COORD) {
+            return Err(MeshError::CoordinateTooLarge {
+                node: i / d,
+                value: coords[i],
+            });
         }
         let measure_name = if d == 2 { "area" } else { "volume" };
         let mut used = vec![false; n_nodes];
@@ -344,7 +419,7 @@ impl<D: Dim> Mesh<D> {
         map: &BTreeMap<String, Vec<u32>>,
         range: &Range,
     ) -> Result<(), MeshError> {
-        range.validate()?;
+        range.validate(D::D)?;
         let mut names = Vec::new();
         range.group_names(&mut names);
         for n in names {
@@ -554,6 +629,33 @@ mod tests {
         assert!(matches!(e, MeshError::NonFiniteCoordinate { node: 1 }));
         let e = Mesh::<Dim2>::new(vec![0.0, 0.0, 1.0], vec![0, 1, 2]).unwrap_err();
         assert!(matches!(e, MeshError::CoordLength { .. }));
+    }
+
+    #[test]
+    fn deserialisation_checks_like_new() {
+        let mut m = square();
+        m.add_node_group("left", vec![0, 3]).unwrap();
+        let json = serde_json::to_string(&m).unwrap();
+        let back: Mesh<Dim2> = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.coords(), m.coords());
+        assert_eq!(back.faces(), m.faces());
+        assert_eq!(back.groups().nodes["left"], vec![0, 3]);
+        for (from, to, what) in [
+            (
+                "\"elements\":[0,1,2,",
+                "\"elements\":[0,1,9,",
+                "refers to node 9",
+            ),
+            ("\"elements\":[0,1,2,", "\"elements\":[0,2,1,", "inverted"),
+            ("\"owner\":[0,", "\"owner\":[1,", "faces.owner[0]"),
+            ("\"left\":[0,3]", "\"left\":[0,7]", "index 7"),
+            ("\"coords\":[0.0,0.0,", "\"coords\":[0.0,", "not a multiple"),
+        ] {
+            assert!(json.contains(from), "{json}");
+            let bad = json.replacen(from, to, 1);
+            let e = serde_json::from_str::<Mesh<Dim2>>(&bad).unwrap_err();
+            assert!(e.to_string().contains(what), "{to}: {e}");
+        }
     }
 
     #[test]

@@ -120,31 +120,92 @@ impl Range {
         Range::Not(Box::new(self))
     }
 
-    /// Checks geometric parameters (non-negative radius and tolerance, non-zero normals).
-    pub fn validate(&self) -> Result<(), crate::MeshError> {
+    /// Checks the range for a mesh of dimension `dim` (2 or 3): only the first `dim`
+    /// components of points and normals count.
+    ///
+    /// A range that can select nothing is an error, as it is almost always a mistake:
+    /// NaN or crossed box corners (`min[k] > max[k]`), a box corner at `+∞` as minimum or
+    /// `-∞` as maximum, a non-finite ball centre or plane point, a NaN or negative radius
+    /// or tolerance, and a plane or half-space normal that is zero or non-finite in the
+    /// first `dim` components (e.g. a z-only normal `[0, 0, 1]` in 2D).
+    pub fn validate(&self, dim: usize) -> Result<(), crate::MeshError> {
         let bad = |s: String| Err(crate::MeshError::InvalidRange(s));
-        match self {
-            Range::Ball { radius, .. } if radius.is_nan() || *radius < 0.0 => {
-                bad(format!("ball radius {radius}"))
+        if dim != 2 && dim != 3 {
+            return bad(format!("dimension {dim}: ranges select in 2D or 3D"));
+        }
+        let point = |what: &str, p: &[f64; 3]| {
+            if p[..dim].iter().all(|v| v.is_finite()) {
+                Ok(())
+            } else {
+                bad(format!(
+                    "{what} {p:?} is not finite: the range selects nothing"
+                ))
             }
-            Range::Plane { normal, tol, .. } => {
-                if tol.is_nan() || *tol < 0.0 {
-                    return bad(format!("plane tolerance {tol}"));
-                }
-                if normal.iter().all(|v| *v == 0.0) || normal.iter().any(|v| !v.is_finite()) {
-                    return bad(format!("plane normal {normal:?}"));
+        };
+        let normal = |what: &str, n: &[f64; 3]| {
+            if n[..dim].iter().any(|v| !v.is_finite()) {
+                return bad(format!("{what} {n:?} is not finite"));
+            }
+            if n[..dim].iter().all(|v| *v == 0.0) {
+                let hint = if dim == 2 && n[2] != 0.0 {
+                    ": a z-only normal has no direction in 2D"
+                } else {
+                    ""
+                };
+                return bad(format!(
+                    "{what} {n:?} is zero in the first {dim} components{hint}"
+                ));
+            }
+            Ok(())
+        };
+        match self {
+            Range::Box { min, max } => {
+                for k in 0..dim {
+                    let (lo, hi) = (min[k], max[k]);
+                    if lo.is_nan() || hi.is_nan() {
+                        return bad(format!(
+                            "box corner min {min:?} / max {max:?} has NaN in component {k}"
+                        ));
+                    }
+                    if lo > hi || lo == f64::INFINITY || hi == f64::NEG_INFINITY {
+                        return bad(format!(
+                            "box min[{k}] = {lo} and max[{k}] = {hi} select nothing (need min <= max, finite or open towards infinity)"
+                        ));
+                    }
                 }
                 Ok(())
             }
-            Range::HalfSpace { normal, .. } if normal.iter().all(|v| *v == 0.0) => {
-                bad(format!("half-space normal {normal:?}"))
+            Range::Ball { center, radius } => {
+                point("ball centre", center)?;
+                if radius.is_nan() || *radius < 0.0 {
+                    return bad(format!("ball radius {radius} must be non-negative"));
+                }
+                Ok(())
+            }
+            Range::Plane {
+                point: p,
+                normal: n,
+                tol,
+            } => {
+                if tol.is_nan() || *tol < 0.0 {
+                    return bad(format!("plane tolerance {tol} must be non-negative"));
+                }
+                point("plane point", p)?;
+                normal("plane normal", n)
+            }
+            Range::HalfSpace {
+                point: p,
+                normal: n,
+            } => {
+                point("half-space point", p)?;
+                normal("half-space normal", n)
             }
             Range::And(a, b) | Range::Or(a, b) => {
-                a.validate()?;
-                b.validate()
+                a.validate(dim)?;
+                b.validate(dim)
             }
-            Range::Not(a) => a.validate(),
-            _ => Ok(()),
+            Range::Not(a) => a.validate(dim),
+            Range::All | Range::Group(_) | Range::Custom(_) => Ok(()),
         }
     }
 
@@ -152,7 +213,7 @@ impl Range {
     /// not nodes, elements or faces (e.g. joints). Group ranges cannot answer for a
     /// point and are an error.
     pub fn contains_point(&self, x: &[f64]) -> Result<bool, crate::MeshError> {
-        self.validate()?;
+        self.validate(x.len())?;
         let mut names = Vec::new();
         self.group_names(&mut names);
         if let Some(g) = names.first() {
@@ -200,5 +261,36 @@ impl Range {
             Range::Not(a) => a.group_names(out),
             _ => {}
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(r: &Range, dim: usize) -> String {
+        r.validate(dim).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn ranges_that_select_nothing_are_refused_per_dimension() {
+        let z_only = Range::plane([0.0; 3], [0.0, 0.0, 1.0], 0.1);
+        assert!(err(&z_only, 2).contains("z-only"));
+        assert!(z_only.validate(3).is_ok());
+        // A NaN z corner only matters in 3D.
+        let nan_z = Range::cuboid([0.0, 0.0, f64::NAN], [1.0; 3]);
+        assert!(nan_z.validate(2).is_ok());
+        assert!(err(&nan_z, 3).contains("component 2"));
+        assert!(err(&Range::rect(1.0, 0.0, 0.0, 1.0), 2).contains("min[0] = 1"));
+        assert!(
+            Range::rect(0.0, 0.0, 0.0, 1.0).validate(2).is_ok(),
+            "a line box"
+        );
+        assert!(err(&Range::All, 1).contains("dimension 1"));
+        let nested = Range::All.or(Range::Ball {
+            center: [f64::NAN; 3],
+            radius: 1.0,
+        });
+        assert!(err(&nested, 2).contains("ball centre"));
     }
 }
