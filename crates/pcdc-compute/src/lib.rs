@@ -7,8 +7,9 @@
 //! central-difference integration (manual 7.1 eq. i-v) with lumped mass and gravity, a
 //! stable time step with a safety factor and a report of the limiting entity, static
 //! mode by dynamic relaxation or a direct sparse solve (manual 7.2.7 "dynamic off"), time
-//! [`Table`]s, [`History`] probes to CSV, a divergence watchdog and save/restore ([`snapshot`]: versioned, checksummed and
-//! fingerprinted, so a damaged or foreign snapshot is an error).
+//! [`Table`]s, [`History`] probes to CSV, a divergence watchdog and save/restore
+//! ([`snapshot`]: versioned, checksummed and fingerprinted, so a damaged or foreign
+//! snapshot is an error).
 //!
 //! Assembly uses no float atomics on either backend: each physics writes forces into its
 //! own slots, registered once per node; each node sums its slots in registration order.

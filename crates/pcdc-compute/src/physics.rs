@@ -199,9 +199,17 @@ pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
 
     /// Restores what [`Physics::save_state`] wrote. The bytes come from a file: check
     /// every length and index against the mesh and return an error (never panic) when
-    /// they do not fit; on error, keep the state held before the call.
-    fn restore_state(&mut self, _bytes: &[u8]) -> Result<(), ComputeError> {
-        Ok(())
+    /// they do not fit; on error, keep the state held before the call. The default
+    /// (no state) accepts only an empty state.
+    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), ComputeError> {
+        if bytes.is_empty() {
+            return Ok(());
+        }
+        Err(ComputeError::SnapshotCorrupt(format!(
+            "physics '{}' keeps no state outside its fields, but the snapshot holds {} bytes for it",
+            self.name(),
+            bytes.len()
+        )))
     }
 
     /// A fingerprint of this physics' parameters (materials, laws, ranges; not its

@@ -332,6 +332,49 @@ fn forged_content_is_refused() {
     assert!(e.contains("left after the payload"), "{e}");
 }
 
+/// A physics with no state of its own (the trait's defaults).
+struct Quiet;
+
+impl Physics<Dim2> for Quiet {
+    fn name(&self) -> &str {
+        "quiet"
+    }
+    fn init(&mut self, _ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
+        Ok(())
+    }
+    fn compute_forces(
+        &self,
+        _ctx: &mut ForceContext<'_, Dim2, CpuBackend>,
+    ) -> Result<(), ComputeError> {
+        Ok(())
+    }
+}
+
+/// The default `restore_state` refuses bytes for a physics that saved none.
+#[test]
+fn stateless_physics_refuse_a_state() {
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    let build = || {
+        Simulation::builder(mesh.clone(), cpu())
+            .physics(Springs::new(1e3, 1.0))
+            .physics(Quiet)
+            .build()
+            .unwrap()
+    };
+    let mut a = build();
+    a.run(2).unwrap();
+    let mut p = decode(&a.snapshot_bytes().unwrap());
+    assert!(p.physics_state[1].is_empty());
+    p.physics_state[1] = vec![0; 5];
+    let mut b = build();
+    let e = b.restore_bytes(&forge(&p)).unwrap_err().to_string();
+    assert!(
+        e.contains("'quiet' keeps no state") && e.contains("5 bytes"),
+        "{e}"
+    );
+    b.restore_bytes(&a.snapshot_bytes().unwrap()).unwrap();
+}
+
 /// A physics that refuses its state gets the others' previous states restored.
 #[test]
 fn physics_states_restore_all_or_nothing() {
