@@ -14,6 +14,7 @@ mod materials;
 mod mesh;
 mod ranges;
 mod scene_files;
+mod snapshots;
 mod tables;
 
 use std::fmt::Display;

@@ -26,8 +26,8 @@ use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
 use pcdc_compute::{
-    Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext, Kinematics,
-    Location, Physics, StableStep,
+    Backend, ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
+    Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
@@ -222,6 +222,20 @@ impl CohesiveJoints {
 impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
     fn name(&self) -> &str {
         "cohesive joints"
+    }
+
+    fn fingerprint(&self) -> u64 {
+        // The joints, the resolved models (parameters through Debug), the model of every
+        // joint and the integration rule.
+        let model_of: Vec<u32> = self.model_of.iter().map(|&m| u32::from(m)).collect();
+        Fingerprint::new()
+            .u32s(&self.joints.nodes)
+            .u32s(&self.joints.elements)
+            .u32s(&self.joints.faces)
+            .debug(&self.models)
+            .u32s(&model_of)
+            .u64(self.gauss_3d as u64)
+            .finish()
     }
 
     fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {

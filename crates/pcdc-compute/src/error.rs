@@ -59,6 +59,13 @@ pub enum ComputeError {
     /// A snapshot does not fit the simulation it is restored into.
     #[error("snapshot mismatch: {0}")]
     SnapshotMismatch(String),
+    /// A snapshot is damaged: truncated, padded, failing its checksum, or holding values
+    /// that no run can produce.
+    #[error("corrupt snapshot: {0}")]
+    SnapshotCorrupt(String),
+    /// A snapshot was written in a format version this build does not read.
+    #[error("snapshot format version {found} is not supported: this build reads version {supported}. Hint: restore it with the pcdc version that wrote it, or re-run the scene to make a new snapshot")]
+    SnapshotVersion { found: u32, supported: u32 },
     /// An input/output error, with the path.
     #[error("{path}: {source}")]
     Io {

@@ -7,7 +7,9 @@
 //! central-difference integration (manual 7.1 eq. i-v) with lumped mass and gravity, a
 //! stable time step with a safety factor and a report of the limiting entity, static
 //! mode by dynamic relaxation or a direct sparse solve (manual 7.2.7 "dynamic off"), time
-//! [`Table`]s, [`History`] probes to CSV, a divergence watchdog and save/restore.
+//! [`Table`]s, [`History`] probes to CSV, a divergence watchdog and save/restore
+//! ([`snapshot`]: versioned, checksummed and fingerprinted, so a damaged or foreign
+//! snapshot is an error).
 //!
 //! Assembly uses no float atomics on either backend: each physics writes forces into its
 //! own slots, registered once per node; each node sums its slots in registration order.
@@ -20,10 +22,12 @@ mod backend;
 mod energy;
 mod error;
 mod field;
+mod fingerprint;
 pub mod gpu;
 mod history;
 mod physics;
 mod simulation;
+pub mod snapshot;
 mod statics;
 mod table;
 
@@ -31,6 +35,7 @@ pub use backend::{Backend, BackendKind, CpuBackend};
 pub use energy::{EnergyBalance, PhysicsEnergy, ENERGY_CHECK_EVERY};
 pub use error::ComputeError;
 pub use field::{names, FieldId, FieldSpec, FieldStore, Location};
+pub use fingerprint::Fingerprint;
 pub use gpu::{BackendChoice, Precision, WgpuBackend};
 pub use history::{History, Probe};
 pub use physics::{

@@ -197,9 +197,29 @@ pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
         Ok(Vec::new())
     }
 
-    /// Restores what [`Physics::save_state`] wrote.
-    fn restore_state(&mut self, _bytes: &[u8]) -> Result<(), ComputeError> {
-        Ok(())
+    /// Restores what [`Physics::save_state`] wrote. The bytes come from a file: check
+    /// every length and index against the mesh and return an error (never panic) when
+    /// they do not fit; on error, keep the state held before the call. The default
+    /// (no state) accepts only an empty state.
+    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), ComputeError> {
+        if bytes.is_empty() {
+            return Ok(());
+        }
+        Err(ComputeError::SnapshotCorrupt(format!(
+            "physics '{}' keeps no state outside its fields, but the snapshot holds {} bytes for it",
+            self.name(),
+            bytes.len()
+        )))
+    }
+
+    /// A fingerprint of this physics' parameters (materials, laws, ranges; not its
+    /// evolving state), e.g. built with [`crate::Fingerprint`], called after
+    /// [`Physics::init`]. Snapshots store it and a restore into a physics whose
+    /// fingerprint differs is refused, naming the physics. The default, 0, leaves the
+    /// physics identified by its name, its declared fields, the nodes of its force slots
+    /// and the mass it lumps (which the snapshot fingerprints for every physics).
+    fn fingerprint(&self) -> u64 {
+        0
     }
 
     /// Declares this physics' GPU kernels, data and signals (GPU backend only); the

@@ -1,12 +1,10 @@
 //! The simulation: builder, explicit central-difference stepping, stable time step,
-//! divergence watchdog, energies and save/restore.
+//! divergence watchdog and energies (save/restore: [`crate::snapshot`]).
 //!
 //! One mechanical step (DESIGN.md): clear slots; every physics computes its forces into
 //! its own slots; each node sums its slots in a fixed order; central-difference update
 //! with lumped mass and gravity, `v += dt (F/m + g)` (manual 7.1 eq. iv); prescribed
 //! kinematics; `u += dt v` (eq. v); watchdog.
-
-use std::path::Path;
 
 use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;
@@ -347,22 +345,6 @@ pub struct Simulation<D: Dim, B: Backend = CpuBackend> {
     pub(crate) energy: Option<Box<EnergyTracker>>,
 }
 
-/// Snapshot file header, checked on restore.
-#[derive(Serialize, Deserialize)]
-struct Snapshot {
-    magic: String,
-    dim: String,
-    n_nodes: usize,
-    n_elements: usize,
-    physics: Vec<String>,
-    dt: f64,
-    state: State,
-    /// Per physics, the state it keeps outside the fields.
-    physics_state: Vec<Vec<u8>>,
-}
-
-const SNAPSHOT_MAGIC: &str = "pcdc-snapshot-2";
-
 impl<D: Dim, B: Backend> Simulation<D, B> {
     /// Starts a builder on `backend` ([`CpuBackend`] or [`crate::WgpuBackend`]).
     pub fn builder(mesh: Mesh<D>, backend: B) -> SimulationBuilder<D, B> {
@@ -611,96 +593,6 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
             entity: format!("node {n}"),
             hint,
         }
-    }
-
-    /// Saves the running state to a file (postcard binary); see [`Simulation::restore`].
-    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), ComputeError> {
-        let path = path.as_ref();
-        let bytes = self.snapshot_bytes()?;
-        std::fs::write(path, bytes).map_err(|source| ComputeError::Io {
-            path: path.display().to_string(),
-            source,
-        })
-    }
-
-    /// Encodes the running state.
-    pub fn snapshot_bytes(&self) -> Result<Vec<u8>, ComputeError> {
-        let snap = Snapshot {
-            magic: SNAPSHOT_MAGIC.to_string(),
-            dim: D::NAME.to_string(),
-            n_nodes: self.mesh.n_nodes(),
-            n_elements: self.mesh.n_elements(),
-            physics: self.physics.iter().map(|p| p.name().to_string()).collect(),
-            dt: self.dt,
-            state: self.state.clone(),
-            physics_state: self
-                .physics
-                .iter()
-                .map(|p| p.save_state())
-                .collect::<Result<_, _>>()?,
-        };
-        postcard::to_stdvec(&snap).map_err(|e| ComputeError::Encoding(e.to_string()))
-    }
-
-    /// Restores a state saved by [`Simulation::save`] into a simulation built from the
-    /// same scene (same mesh and physics); continuing then equals the uninterrupted run
-    /// bit for bit.
-    pub fn restore(&mut self, path: impl AsRef<Path>) -> Result<(), ComputeError> {
-        let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|source| ComputeError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
-        self.restore_bytes(&bytes)
-    }
-
-    /// Restores from bytes made by [`Simulation::snapshot_bytes`].
-    pub fn restore_bytes(&mut self, bytes: &[u8]) -> Result<(), ComputeError> {
-        let snap: Snapshot =
-            postcard::from_bytes(bytes).map_err(|e| ComputeError::Encoding(e.to_string()))?;
-        let mismatch = |what: String| Err(ComputeError::SnapshotMismatch(what));
-        if snap.magic != SNAPSHOT_MAGIC {
-            return mismatch(format!("not a pcdc snapshot (header '{}')", snap.magic));
-        }
-        if snap.dim != D::NAME
-            || snap.n_nodes != self.mesh.n_nodes()
-            || snap.n_elements != self.mesh.n_elements()
-        {
-            return mismatch(format!(
-                "snapshot is {} with {} nodes and {} elements; simulation is {} with {} nodes and {} elements",
-                snap.dim, snap.n_nodes, snap.n_elements, D::NAME, self.mesh.n_nodes(), self.mesh.n_elements()
-            ));
-        }
-        let names: Vec<String> = self.physics.iter().map(|p| p.name().to_string()).collect();
-        if snap.physics != names {
-            return mismatch(format!(
-                "snapshot physics {:?}, simulation physics {:?}",
-                snap.physics, names
-            ));
-        }
-        if !snap.state.fields.same_layout(&self.state.fields) {
-            return mismatch("field layouts differ".to_string());
-        }
-        if snap.state.u.len() != self.state.u.len() || snap.state.v.len() != self.state.v.len() {
-            return mismatch(format!(
-                "node arrays hold {} and {} values, expected {}",
-                snap.state.u.len(),
-                snap.state.v.len(),
-                self.state.u.len()
-            ));
-        }
-        if !(snap.dt > 0.0 && snap.dt.is_finite()) {
-            return mismatch(format!("time step {} is not positive", snap.dt));
-        }
-        if snap.physics_state.len() != self.physics.len() {
-            return mismatch("physics state count differs".to_string());
-        }
-        for (p, bytes) in self.physics.iter_mut().zip(&snap.physics_state) {
-            p.restore_state(bytes)?;
-        }
-        self.state = snap.state;
-        self.dt = snap.dt;
-        Ok(())
     }
 }
 

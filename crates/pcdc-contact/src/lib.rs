@@ -34,6 +34,7 @@ mod model;
 mod physics;
 mod potential2d;
 mod potential3d;
+mod snapshot_state;
 
 pub use model::{
     ContactDamping, ContactModel, ContactStress, Friction, MohrCoulombContact, SurfaceContact,

@@ -38,8 +38,8 @@
 use std::sync::Mutex;
 
 use pcdc_compute::{
-    Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext, Kinematics,
-    Location, Physics, StableStep,
+    Backend, ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
+    Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;
@@ -51,6 +51,11 @@ use crate::{tet_pair_force, triangle_pair_force, PairForce2, PairForce3};
 
 /// Node positions at the last broad-phase build (m), stride D.
 pub const CONTACT_REFERENCE: &str = "contact_reference_positions";
+
+/// The error of a lock poisoned by an earlier panic.
+fn poisoned_state() -> ComputeError {
+    ComputeError::physics("contact", "state poisoned by an earlier panic")
+}
 
 /// Applies the contact law to a pair's normal (potential) forces: trial stress
 /// σ_try = |F_n| / h, slip increment from the relative tangential velocity of the two
@@ -200,6 +205,8 @@ pub struct Contact {
     /// The law in force (set by init): the custom model or `contact-m-c`.
     model: Option<Arc<dyn ContactModel>>,
     n_state: usize,
+    /// Elements of the mesh (set by init; bounds the candidate indices of a restore).
+    n_elements: usize,
     skin: Option<f64>,
     gpu_capacity: Option<usize>,
     bonds: Option<Bonds>,
@@ -246,6 +253,7 @@ impl Contact {
             custom: None,
             model: None,
             n_state: 0,
+            n_elements: 0,
             skin: None,
             gpu_capacity: None,
             bonds: None,
@@ -717,6 +725,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         model.check()?;
         model.check_mesh(ctx.mesh.n_elements())?;
         self.n_state = model.n_state();
+        self.n_elements = ctx.mesh.n_elements();
         self.model = Some(model);
         let (lo, _) = ctx.mesh.edge_length_range();
         self.skin_used = self.skin.unwrap_or(0.5 * lo);
@@ -796,57 +805,15 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
     }
 
     fn save_state(&self) -> Result<Vec<u8>, ComputeError> {
-        // Candidate lists and pair histories, little-endian: count, then per element its
-        // list length, partners (u32) and n_state values per partner (f64).
-        let poisoned = || ComputeError::physics("contact", "state poisoned by an earlier panic");
-        let cand = self.candidates.lock().map_err(|_| poisoned())?;
-        let slips = self.slips.lock().map_err(|_| poisoned())?;
-        let mut out = Vec::new();
-        out.extend_from_slice(&(cand.len() as u64).to_le_bytes());
-        for (list, slip) in cand
-            .iter()
-            .zip(slips.iter().chain(std::iter::repeat(&Vec::new())))
-        {
-            out.extend_from_slice(&(list.len() as u64).to_le_bytes());
-            for f in list {
-                out.extend_from_slice(&f.to_le_bytes());
-            }
-            for k in 0..list.len() * self.n_state {
-                out.extend_from_slice(&slip.get(k).copied().unwrap_or(0.0).to_le_bytes());
-            }
-        }
-        Ok(out)
+        let cand = self.candidates.lock().map_err(|_| poisoned_state())?;
+        let slips = self.slips.lock().map_err(|_| poisoned_state())?;
+        Ok(crate::snapshot_state::encode(&cand, &slips, self.n_state))
     }
 
     fn restore_state(&mut self, bytes: &[u8]) -> Result<(), ComputeError> {
-        let bad = || ComputeError::SnapshotMismatch("contact state is truncated or corrupt".into());
-        let mut pos = 0usize;
-        let mut take = |n: usize| -> Result<&[u8], ComputeError> {
-            let s = bytes.get(pos..pos + n).ok_or_else(bad)?;
-            pos += n;
-            Ok(s)
-        };
-        let count = u64::from_le_bytes(take(8)?.try_into().map_err(|_| bad())?) as usize;
-        if count > bytes.len() {
-            return Err(bad());
-        }
-        let (mut cand, mut slips) = (Vec::with_capacity(count), Vec::with_capacity(count));
-        for _ in 0..count {
-            let len = u64::from_le_bytes(take(8)?.try_into().map_err(|_| bad())?) as usize;
-            if len > bytes.len() {
-                return Err(bad());
-            }
-            let list: Vec<u32> = (0..len)
-                .map(|_| take(4).map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes"))))
-                .collect::<Result<_, _>>()?;
-            let slip: Vec<f64> = (0..len * self.n_state)
-                .map(|_| take(8).map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes"))))
-                .collect::<Result<_, _>>()?;
-            cand.push(list);
-            slips.push(slip);
-        }
-        *self.candidates.get_mut().map_err(|_| bad())? = cand;
-        *self.slips.get_mut().map_err(|_| bad())? = slips;
+        let (cand, slips) = crate::snapshot_state::decode(bytes, self.n_elements, self.n_state)?;
+        *self.candidates.get_mut().map_err(|_| poisoned_state())? = cand;
+        *self.slips.get_mut().map_err(|_| poisoned_state())? = slips;
         Ok(())
     }
 
@@ -855,6 +822,18 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
             "contact forces on element {}",
             slot / D::NODES_PER_ELEM
         ))
+    }
+
+    fn fingerprint(&self) -> u64 {
+        let mut h = Fingerprint::new()
+            .f64(self.penalty)
+            .debug(&self.model)
+            .f64(self.skin_used)
+            .u64(self.n_state as u64);
+        if let Some(b) = &self.bonds {
+            h = h.u32s(&b.elements).u32s(&b.faces).str(&b.field);
+        }
+        h.finish()
     }
 
     fn stable_step(&self, kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {

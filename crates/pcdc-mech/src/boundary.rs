@@ -15,8 +15,8 @@
 
 use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
 use pcdc_compute::{
-    Backend, ComputeError, DofConstraint, FieldId, FieldSpec, FieldStore, ForceContext,
-    InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext,
+    Backend, ComputeError, DofConstraint, FieldId, FieldSpec, FieldStore, Fingerprint,
+    ForceContext, InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
 
@@ -275,6 +275,14 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
     /// Face tractions and node forces are applied loads: external work.
     fn applies_loads(&self) -> bool {
         true
+    }
+
+    fn fingerprint(&self) -> u64 {
+        // The conditions (ranges, values, tables) and the nodes and faces they resolved to.
+        Fingerprint::new()
+            .debug(&self.items)
+            .debug(&self.resolved)
+            .finish()
     }
 
     fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {

@@ -12,8 +12,8 @@ use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase};
 use pcdc_compute::{
-    names, Backend, ComputeError, FieldId, FieldSpec, FieldStore, ForceContext, InitContext,
-    Kinematics, Location, Physics, StableStep,
+    names, Backend, ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext,
+    InitContext, Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
@@ -486,6 +486,17 @@ impl Mechanics {
 impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
     fn name(&self) -> &str {
         "mechanics"
+    }
+
+    fn fingerprint(&self) -> u64 {
+        // The resolved models (their parameters, through Debug), the model of every
+        // element and the initial stresses.
+        let material: Vec<u32> = self.material.iter().map(|&m| u32::from(m)).collect();
+        Fingerprint::new()
+            .debug(&self.models)
+            .u32s(&material)
+            .debug(&self.initial_stress)
+            .finish()
     }
 
     fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {

@@ -1,0 +1,228 @@
+//! Snapshots of a fracturing FDEM scene with contact are never trusted blindly: single-bit
+//! flips spread over the whole file and truncations at many lengths are all errors,
+//! never panics; snapshots forged with a valid checksum but out-of-range, self or
+//! unordered contact candidates are errors; a snapshot of another mesh with the same
+//! counts, or of another physics composition, is refused by name; and after all that the
+//! simulation still restores the real snapshot and continues bit for bit.
+//!
+//! The scene: an FDEM block (every triangle with its own nodes, cohesive joints between
+//! them, declared as bonded pairs) hits a second block hard enough that joints break and
+//! their faces become contact faces (as in the GPU parity tests, on the CPU).
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE};
+use pcdc_compute::{ComputeError, CpuBackend, Simulation};
+use pcdc_contact::Contact;
+use pcdc_mech::{LinearElastic, Mechanics};
+use pcdc_mesh::{builders, Dim2, Range};
+
+const E: f64 = 1e9;
+
+/// The scene with the struck block's left edge at `x_struck` (0.061 m) and contact
+/// friction `friction` (degrees).
+fn fdem(x_struck: f64, friction: f64) -> Simulation<Dim2> {
+    let a = builders::rectangle(0.0, 0.0, 0.06, 0.06, 0.01).unwrap();
+    let b = builders::rectangle(x_struck, -0.02, 0.04, 0.1, 0.01).unwrap();
+    let mesh = builders::union(&[&a, &b]).unwrap().0;
+    let split = split_nodes(&mesh, &Range::rect(-1.0, -1.0, 0.0605, 1.0)).unwrap();
+    let czm = IntrinsicCzm::new(30.0, 4e6, 2e6, 0.01, 0.1, 10.0 * E, 10.0 * E, 10.0 * E).unwrap();
+    let bond_faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
+    let contact = Contact::new(10.0 * E)
+        .friction(friction, 10.0 * E)
+        .bonded_pairs(&split.joints.elements, &bond_faces, BROKEN_FACE);
+    let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
+    let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(1).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(CohesiveJoints::new(split.joints.clone()).model(Range::All, czm))
+        .physics(contact)
+        .build()
+        .unwrap();
+    let x = sim.mesh().coords().to_vec();
+    for n in 0..sim.mesh().n_nodes() {
+        if x[2 * n] < 0.0605 {
+            sim.state.v[2 * n] = 3.0;
+        }
+    }
+    sim
+}
+
+fn scene() -> Simulation<Dim2> {
+    fdem(0.061, 20.0)
+}
+
+/// Steps to the snapshot (1 ms: joints have broken) and after it.
+fn steps(sim: &Simulation<Dim2>) -> u64 {
+    (1e-3 / sim.dt()).ceil() as u64
+}
+
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+/// Restores `bytes` into `sim`, catching panics: `Some(result)`, or `None` on a panic.
+fn try_restore(sim: &mut Simulation<Dim2>, bytes: &[u8]) -> Option<Result<(), ComputeError>> {
+    catch_unwind(AssertUnwindSafe(|| sim.restore_bytes(bytes))).ok()
+}
+
+/// Position of the contact state (the last bytes of the file) and its history length
+/// per pair: the offset from which the documented layout (count = elements, then per
+/// element a length, partners and histories) ends exactly at the end of the file.
+fn contact_state(bytes: &[u8], ne: usize) -> (usize, usize) {
+    let parse = |start: usize, ns: usize| -> bool {
+        let mut pos = start + 8;
+        for _ in 0..ne {
+            let Some(len) = bytes.get(pos..pos + 8) else {
+                return false;
+            };
+            let len = u64::from_le_bytes(len.try_into().unwrap()) as usize;
+            if len >= ne {
+                return false;
+            }
+            pos += 8 + len * (4 + 8 * ns);
+        }
+        pos == bytes.len()
+    };
+    let key = (ne as u64).to_le_bytes();
+    (0..bytes.len() - 8)
+        .rev()
+        .filter(|&p| bytes[p..p + 8] == key)
+        .find_map(|p| (0..=4).find(|&ns| parse(p, ns)).map(|ns| (p, ns)))
+        .expect("contact state at the end of the snapshot")
+}
+
+/// Offset of candidate `k` of the first element with at least `k + 2` candidates, and
+/// that element.
+fn candidate(bytes: &[u8], start: usize, ns: usize, ne: usize, k: usize) -> (usize, usize) {
+    let mut pos = start + 8;
+    for e in 0..ne {
+        let len = u64::from_le_bytes(bytes[pos..pos + 8].try_into().unwrap()) as usize;
+        if len >= k + 2 {
+            return (pos + 8 + 4 * k, e);
+        }
+        pos += 8 + len * (4 + 8 * ns);
+    }
+    panic!("no element with {} candidates", k + 2);
+}
+
+/// Writes a valid checksum for the (edited) file: CRC-32 of bytes 16.. at offset 12.
+fn reseal(bytes: &mut [u8]) {
+    let crc = crc32fast::hash(&bytes[16..]);
+    bytes[12..16].copy_from_slice(&crc.to_le_bytes());
+}
+
+#[test]
+fn fracturing_snapshot_fuzz() {
+    let mut a = scene();
+    let n = steps(&a);
+    a.run(n).unwrap();
+    let broken = a
+        .field(BROKEN_FACE)
+        .unwrap()
+        .iter()
+        .filter(|&&f| f != 0.0)
+        .count();
+    assert!(
+        broken > 0,
+        "no joint broke: the snapshot would not be of a fracturing scene"
+    );
+    let snap = a.snapshot_bytes().unwrap();
+    a.run(n).unwrap();
+
+    let mut b = scene();
+    let ne = b.mesh().n_elements();
+    assert!(ne >= 100, "{ne} elements");
+    // Single-bit flips: every bit of the 24-byte header, and 400 bits spread over the
+    // file by a multiplicative (Knuth) sequence.
+    let bits = snap.len() * 8;
+    let positions: Vec<usize> = (0..24 * 8)
+        .chain((0..400u64).map(|i| ((i * 2_654_435_761) % bits as u64) as usize))
+        .collect();
+    let (mut errors, mut accepted, mut panics) = (0, 0, 0);
+    for &bit in &positions {
+        let mut bad = snap.clone();
+        bad[bit / 8] ^= 1 << (bit % 8);
+        match try_restore(&mut b, &bad) {
+            Some(Err(_)) => errors += 1,
+            Some(Ok(())) => accepted += 1,
+            None => panics += 1,
+        }
+    }
+    // Truncations at 60 lengths spread over the file, and every length of the header.
+    let lengths: Vec<usize> = (0..=24)
+        .chain((0..60).map(|i| i * snap.len() / 60))
+        .collect();
+    let (mut t_errors, mut t_other) = (0, 0);
+    for &len in &lengths {
+        match try_restore(&mut b, &snap[..len]) {
+            Some(Err(_)) => t_errors += 1,
+            _ => t_other += 1,
+        }
+    }
+    println!(
+        "snapshot {} bytes, {ne} elements, {broken} broken faces: {} flips -> {errors} errors, \
+         {accepted} accepted, {panics} panics; {} truncations -> {t_errors} errors, {t_other} other",
+        snap.len(),
+        positions.len(),
+        lengths.len()
+    );
+    assert_eq!((accepted, panics), (0, 0));
+    assert_eq!(errors, positions.len());
+    assert_eq!((t_errors, t_other), (lengths.len(), 0));
+
+    // Forged with a valid checksum: a candidate out of range, the element itself, and
+    // two candidates out of order.
+    let (start, ns) = contact_state(&snap, ne);
+    let (at, e) = candidate(&snap, start, ns, ne, 0);
+    for what in ["out of range", "itself", "order"] {
+        let mut bad = snap.clone();
+        match what {
+            "out of range" => bad[at..at + 4].copy_from_slice(&(ne as u32 + 5).to_le_bytes()),
+            "itself" => bad[at..at + 4].copy_from_slice(&(e as u32).to_le_bytes()),
+            _ => {
+                // Swap the first two candidates.
+                let first: [u8; 4] = bad[at..at + 4].try_into().unwrap();
+                bad.copy_within(at + 4..at + 8, at);
+                bad[at + 4..at + 8].copy_from_slice(&first);
+            }
+        }
+        reseal(&mut bad);
+        let e = try_restore(&mut b, &bad)
+            .unwrap_or_else(|| panic!("{what}: panic"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("contact state"), "{what}: {e}");
+    }
+
+    // The simulation is untouched by every refused snapshot: restoring the real one and
+    // continuing equals the uninterrupted run bit for bit.
+    b.restore_bytes(&snap).unwrap();
+    b.run(n).unwrap();
+    assert!(same_bits(&a.state.u, &b.state.u));
+    assert!(same_bits(&a.state.v, &b.state.v));
+}
+
+#[test]
+fn foreign_fracturing_snapshots_are_refused() {
+    let mut a = scene();
+    a.run(50).unwrap();
+    let snap = a.snapshot_bytes().unwrap();
+    // The struck block 1 mm further right: same counts, other coordinates.
+    let mut shifted = fdem(0.062, 20.0);
+    assert_eq!(shifted.mesh().n_nodes(), a.mesh().n_nodes());
+    let e = shifted.restore_bytes(&snap).unwrap_err().to_string();
+    assert!(e.contains("different mesh"), "{e}");
+    // Another friction angle.
+    let mut other = fdem(0.061, 30.0);
+    let e = other.restore_bytes(&snap).unwrap_err().to_string();
+    assert!(e.contains("physics 'contact'"), "{e}");
+    // Another composition: no contact.
+    let mesh = a.mesh().clone();
+    let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
+    let mut plain = Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock))
+        .build()
+        .unwrap();
+    let e = plain.restore_bytes(&snap).unwrap_err().to_string();
+    assert!(e.contains("composes the physics"), "{e}");
+}
