@@ -249,7 +249,7 @@ pub fn deepest_penetration(mesh: &Mesh<Dim2>, x: &[f64], own: &[Vec<u32>]) -> f6
             cell = cell.max(b - a);
         }
     }
-    if !(cell > 0.0) || !lo.iter().chain(&hi).all(|v| v.is_finite()) {
+    if cell.is_nan() || cell <= 0.0 || !lo.iter().chain(&hi).all(|v| v.is_finite()) {
         return f64::INFINITY;
     }
     let nx = (((hi[0] - lo[0]) / cell).ceil() as usize).clamp(1, 4096);
