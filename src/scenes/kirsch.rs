@@ -13,6 +13,12 @@
 //!
 //! Error metric: max |σ_num − σ_exact| over both components and all sample points,
 //! divided by max |σθ| on the same range. Tolerance 3 %.
+//!
+//! Mesh limit: with linear triangles and nodal-averaged stresses the error is 4.9 % at
+//! an element size of a/10 at the hole (the first sample point, 1.1 a, lies inside the
+//! first ring of elements, where the nodal average is one-sided), 1.7 % at a/20 and
+//! 1.2 % at a/40 (direct solve; relaxation within 0.03 % of it). a/20 is the coarsest
+//! mesh that meets the tolerance; the full scene uses a/40.
 
 use std::time::Instant;
 

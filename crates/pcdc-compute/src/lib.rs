@@ -7,7 +7,10 @@
 //! central-difference integration (manual 7.1 eq. i-v) with lumped mass and gravity, a
 //! stable time step with a safety factor and a report of the limiting entity, static
 //! mode by dynamic relaxation or a direct sparse solve (manual 7.2.7 "dynamic off"), time
-//! [`Table`]s, [`History`] probes to CSV, a divergence watchdog and save/restore
+//! [`Table`]s, [`History`] probes to CSV, a divergence watchdog, an energy balance with
+//! an energy watchdog ([`EnergyBalance`]: the work of every force source, each physics'
+//! inferred dissipation, a stop naming the physics and entity that inject energy) and
+//! save/restore
 //! ([`snapshot`]: versioned, checksummed and fingerprinted, so a damaged or foreign
 //! snapshot is an error).
 //!
