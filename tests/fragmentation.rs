@@ -44,3 +44,54 @@ fn fragments_in_a_box_stay_stable_for_100k_steps() {
         o.worst_penetration
     );
 }
+
+/// The same scene on the GPU (f64): 10 000 steps at 1 cm (the impact and the shattering)
+/// in CI; the energy balance (accumulated on the device) and the penetration stay within
+/// the bounds. The full 100 000 steps: `cargo test --release --test fragmentation --
+/// --ignored` (about 15 min on lavapipe).
+#[test]
+fn fragments_on_the_gpu_f64_stay_stable() {
+    gpu_run(10_000);
+}
+
+/// 100 000 steps on the GPU (f64); ignored in CI for its length on a software adapter.
+#[test]
+#[ignore]
+fn fragments_on_the_gpu_f64_stay_stable_for_100k_steps() {
+    gpu_run(100_000);
+}
+
+fn gpu_run(steps: u64) {
+    let Some(gpu) = pcdc::compute::gpu::gpu_test_backend(Some(pcdc::compute::Precision::F64))
+    else {
+        return;
+    };
+    let p = Params {
+        size: 0.01,
+        steps,
+        check_every: 1000,
+    };
+    let o = run(&gpu, &p).expect("no watchdog stop");
+    println!(
+        "GPU f64: {} steps, broken {}/{}, worst excess {:.3e} at {}, penetration {:.3e}, {:.1} s",
+        o.steps,
+        o.broken,
+        o.joints,
+        o.worst_energy_excess,
+        o.worst_step,
+        o.worst_penetration,
+        o.wall_s
+    );
+    assert_eq!(o.steps, steps);
+    assert!(o.broken > 0, "nothing broke");
+    assert!(
+        o.worst_energy_excess <= ENERGY_TOL,
+        "energy excess {}",
+        o.worst_energy_excess
+    );
+    assert!(
+        o.worst_penetration <= PENETRATION_TOL,
+        "penetration {}",
+        o.worst_penetration
+    );
+}
