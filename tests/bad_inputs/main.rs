@@ -8,6 +8,7 @@
 //! do not depend on the machine.
 
 mod boundary;
+mod contact;
 mod gmsh;
 mod joints;
 mod materials;
