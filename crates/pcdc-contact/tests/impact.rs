@@ -162,3 +162,31 @@ fn user_contact_model_plugs_in() {
     assert!((p1 - p0).abs() <= 1e-10 * scale);
     assert_ne!(capped.state.u, built_in.state.u);
 }
+
+/// The friction spring (eq. 59 corrected, τ = P_t δ_s / h) enters the contact stable
+/// step: a shear penalty above three normal penalties (the normal potential's node
+/// stiffness) lowers the contact limit as 1/√P_t; below it, the normal penalty governs.
+#[test]
+fn a_stiff_friction_spring_lowers_the_contact_time_step() {
+    let limit = |contact: Contact| {
+        let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
+        let sim = Simulation::builder(two_blocks(), CpuBackend::new(1).unwrap())
+            .physics(Mechanics::new().material(Range::All, rock))
+            .physics(contact)
+            .build()
+            .unwrap();
+        let l = sim.time_step_limit().unwrap().clone();
+        assert_eq!(l.physics, "contact", "{l:?}");
+        l.dt
+    };
+    let p = 1000.0 * E; // well above the elements' own limit
+    let plain = limit(Contact::new(p));
+    let soft = limit(Contact::new(p).friction(30.0, p));
+    let stiff = limit(Contact::new(p).friction(30.0, 12.0 * p));
+    assert_eq!(plain, soft, "a shear penalty below 3 P_n changes nothing");
+    let ratio = plain / stiff;
+    assert!(
+        (ratio - 2.0).abs() < 1e-12,
+        "dt ratio {ratio}, expected sqrt(12/3) = 2"
+    );
+}
