@@ -203,3 +203,105 @@ fn si_and_mm_n_s_agree() {
 fn large_scene_si_and_km_mn_s_agree() {
     compare(1000.0, Units::KM_MN_S, 1000);
 }
+
+/// The 3D counterpart: an FDEM cube of tetrahedra (cohesive joints on its interior
+/// faces), spinning, is driven into a fixed base and slides on it with friction, in SI
+/// and in mm–N–s.
+fn run_3d(u: Units, steps: u64, eps: f64) -> Outcome {
+    use pcdc::mesh::Dim3;
+    let len = |x: f64| x / u.length;
+    let e = 1e8 / u.stress();
+    let base = builders::cuboid([0.0; 3], [len(0.15), len(0.06), len(0.02)], len(0.02)).unwrap();
+    let block = builders::cuboid(
+        [len(0.02), len(0.01), len(0.02)],
+        [len(0.04), len(0.04), len(0.04)],
+        len(0.02),
+    )
+    .unwrap();
+    let (mesh, bodies) = builders::union(&[&base, &block]).unwrap();
+    let fdem = Range::cuboid([len(0.0199), len(0.0099), len(0.0201)], [len(0.0601); 3]);
+    let split = split_nodes(&mesh, &fdem).unwrap();
+    let rock = LinearElastic::new(e, 0.25, 2600.0 / u.density()).unwrap();
+    let czm = IntrinsicCzm::new(
+        30.0,
+        4e4 / u.stress(),
+        1e4 / u.stress(),
+        1.0 / u.energy_per_area(),
+        5.0 / u.energy_per_area(),
+        10.0 * e,
+        10.0 * e,
+        10.0 * e,
+    )
+    .unwrap();
+    let faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
+    let contact = Contact::new(10.0 * e)
+        .friction(30.0, 10.0 * e)
+        .bonded_pairs(&split.joints.elements, &faces, BROKEN_FACE);
+    let fixed = Range::cuboid([len(-1.0); 3], [len(1.0), len(1.0), len(0.0199)]);
+    let mut sim = Simulation::builder(split.mesh, CpuBackend::new(1).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
+        .physics(contact)
+        .physics(Boundary::new().fix(fixed))
+        .gravity([0.0, 0.0, -9.81 / u.acceleration()])
+        .build()
+        .unwrap();
+    let v0 = 2.0 / u.velocity() * (1.0 + eps);
+    let omega = 60.0 * u.time;
+    let (cx, cy) = (len(0.04), len(0.03));
+    let mut in_block: Vec<usize> = sim
+        .mesh()
+        .select_elements(&fdem)
+        .unwrap()
+        .iter()
+        .flat_map(|&el| sim.mesh().element(el as usize).to_vec())
+        .map(|n| n as usize)
+        .collect();
+    in_block.sort_unstable();
+    in_block.dedup();
+    assert!(!in_block.is_empty() && bodies.len() == 2);
+    for &n in &in_block {
+        let x = sim.mesh().node(n).to_vec();
+        sim.state.v[3 * n] = v0 - omega * (x[1] - cy);
+        sim.state.v[3 * n + 1] = omega * (x[0] - cx);
+        // Driven into the base: the impact fractures the cube.
+        sim.state.v[3 * n + 2] = -1.5 * v0;
+    }
+    let ke0 = sim.kinetic_energy();
+    sim.run(steps).unwrap();
+    let l0 = len(0.15);
+    let _: &Simulation<Dim3> = &sim;
+    Outcome {
+        x: sim.positions().iter().map(|x| x / l0).collect(),
+        v: sim.state.v.iter().map(|v| v / v0).collect(),
+        broken: sim
+            .field(JOINT_DAMAGE)
+            .unwrap()
+            .iter()
+            .filter(|&&d| d >= 1.0)
+            .count(),
+        kinetic: sim.kinetic_energy() / ke0,
+        time: sim.state.time * v0 / l0,
+        steps: sim.state.step,
+    }
+}
+
+#[test]
+fn three_d_si_and_mm_n_s_agree() {
+    let steps = 600;
+    let a = run_3d(Units::SI, steps, 0.0);
+    let b = run_3d(Units::MM_N_S, steps, 0.0);
+    let c = run_3d(Units::SI, steps, 1e-15);
+    let (dx, dv) = (rel(&a.x, &b.x), rel(&a.v, &b.v));
+    let (px, pv) = (rel(&a.x, &c.x), rel(&a.v, &c.v));
+    println!(
+        "3D: broken {} / {}, KE/KE0 {:.9} / {:.9}, |dx| {dx:.2e} ({px:.2e}), |dv| {dv:.2e} ({pv:.2e})",
+        a.broken, b.broken, a.kinetic, b.kinetic
+    );
+    assert_eq!(a.steps, b.steps);
+    assert!((a.time - b.time).abs() <= 1e-12 * a.time);
+    assert!(a.broken > 0, "the 3D scene must fracture");
+    assert_eq!(a.broken, b.broken, "broken joints differ");
+    assert!(dx <= (100.0 * px).max(1e-13), "positions differ by {dx:e}");
+    assert!(dv <= (100.0 * pv).max(1e-10), "velocities differ by {dv:e}");
+}
