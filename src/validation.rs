@@ -411,12 +411,10 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
         "Limits measured, not hidden: (1) Kirsch with linear triangles and nodal-averaged \
          stresses gave 4.9 % at a/10 (the first sample point, 1.1 a, lies in the first ring \
          of elements, where the nodal average is one-sided), 1.7 % at a/20 and 1.2 % at \
-         a/40, so the report starts at a/20. (2) In f32 a position near |x| is resolved to \
-         about 6e-8 |x|: a contact whose equilibrium overlap σn h / Pn is below that cannot \
-         resolve its normal force, which chatters, and the friction with it. The block \
-         sliding scene (σn ≈ 490 Pa, Pn = 1 GPa) has overlaps of 25, 12 and 6 nm at its \
-         three sizes against 15–30 nm of f32 resolution along its path: use f64 for \
-         low-stress frictional contact (or a softer penalty).\n\n",
+         a/40, so the report starts at a/20. (2) Block sliding in f32 failed (1.4 %, 43 %, \
+         149 %) with the manual's friction law as printed (τ = P_t h δ, a shear spring \
+         1/h² times too soft) and damping 1; with the corrected law τ = P_t δ / h and \
+         damping 0.1 it passes (rows below).\n\n",
     );
     s.push_str("![error against wall time](validation-error-vs-time.png)\n\n");
     s.push_str("| case | variant | mesh size (m) | elements | backend | precision | error | tolerance | pass | steps | wall (s) | element-steps/s |\n");
