@@ -13,7 +13,7 @@ use pcdc::cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE, JOI
 use pcdc::compute::{CpuBackend, Simulation};
 use pcdc::contact::Contact;
 use pcdc::mech::{Boundary, LinearElastic, Mechanics};
-use pcdc::mesh::{builders, Range};
+use pcdc::mesh::{builders, Dim, Range};
 
 /// A unit system: length (m), force (N) and time (s) units.
 #[derive(Clone, Copy, Debug)]
@@ -67,12 +67,8 @@ struct Outcome {
     steps: u64,
 }
 
-/// The scene of physical size `scale` × (0.3 m box), written in units `u`; `steps` steps.
-fn run(scale: f64, u: Units, steps: u64) -> Outcome {
-    run_perturbed(scale, u, steps, 0.0)
-}
-
-/// [`run`] with the initial speed scaled by 1 + `eps` (the scene's sensitivity).
+/// The scene of physical size `scale` × (0.3 m long base), written in units `u`, run for
+/// `steps` steps, with the initial speed scaled by 1 + `eps` (the scene's sensitivity).
 fn run_perturbed(scale: f64, u: Units, steps: u64, eps: f64) -> Outcome {
     let len = |x: f64| scale * x / u.length;
     let e = 30e9 / u.stress();
@@ -132,9 +128,14 @@ fn run_perturbed(scale: f64, u: Units, steps: u64, eps: f64) -> Outcome {
         sim.state.v[2 * n] = v0 - omega * (x[1] - cy);
         sim.state.v[2 * n + 1] = omega * (x[0] - cx);
     }
+    finish(&mut sim, steps, v0, len(0.3))
+}
+
+/// Runs `steps` steps and returns the dimensionless outcome (positions over the scene
+/// size `l0`, velocities over the initial speed `v0`).
+fn finish<D: Dim>(sim: &mut Simulation<D>, steps: u64, v0: f64, l0: f64) -> Outcome {
     let ke0 = sim.kinetic_energy();
     sim.run(steps).unwrap();
-    let l0 = len(0.3);
     Outcome {
         x: sim.positions().iter().map(|x| x / l0).collect(),
         v: sim.state.v.iter().map(|v| v / v0).collect(),
@@ -164,13 +165,20 @@ fn rel(a: &[f64], b: &[f64]) -> f64 {
 /// "the same to rounding" means no further apart than that perturbation takes the SI
 /// run (with a factor 100 of margin), and the same joints broken.
 fn compare(scale: f64, other: Units, steps: u64) {
-    let a = run(scale, Units::SI, steps);
-    let b = run(scale, other, steps);
-    let c = run_perturbed(scale, Units::SI, steps, 1e-15);
+    compare_runs(&format!("scale {scale}"), other, |u, eps| {
+        run_perturbed(scale, u, steps, eps)
+    });
+}
+
+/// The comparison itself, for a scene `run(units, eps)`.
+fn compare_runs(label: &str, other: Units, run: impl Fn(Units, f64) -> Outcome) {
+    let a = run(Units::SI, 0.0);
+    let b = run(other, 0.0);
+    let c = run(Units::SI, 1e-15);
     let (dx, dv) = (rel(&a.x, &b.x), rel(&a.v, &b.v));
     let (px, pv) = (rel(&a.x, &c.x), rel(&a.v, &c.v));
     println!(
-        "scale {scale}, units {other:?}: broken {} / {}, KE/KE0 {:.9} / {:.9}, |dx| {dx:.2e} (perturbed SI {px:.2e}), |dv| {dv:.2e} ({pv:.2e})",
+        "{label}, units {other:?}: broken {} / {}, KE/KE0 {:.9} / {:.9}, |dx| {dx:.2e} (perturbed SI {px:.2e}), |dv| {dv:.2e} ({pv:.2e})",
         a.broken, b.broken, a.kinetic, b.kinetic
     );
     assert_eq!(a.steps, b.steps);
@@ -208,7 +216,6 @@ fn large_scene_si_and_km_mn_s_agree() {
 /// faces), spinning, is driven into a fixed base and slides on it with friction, in SI
 /// and in mm–N–s.
 fn run_3d(u: Units, steps: u64, eps: f64) -> Outcome {
-    use pcdc::mesh::Dim3;
     let len = |x: f64| x / u.length;
     let e = 1e8 / u.stress();
     let base = builders::cuboid([0.0; 3], [len(0.15), len(0.06), len(0.02)], len(0.02)).unwrap();
@@ -267,41 +274,10 @@ fn run_3d(u: Units, steps: u64, eps: f64) -> Outcome {
         // Driven into the base: the impact fractures the cube.
         sim.state.v[3 * n + 2] = -1.5 * v0;
     }
-    let ke0 = sim.kinetic_energy();
-    sim.run(steps).unwrap();
-    let l0 = len(0.15);
-    let _: &Simulation<Dim3> = &sim;
-    Outcome {
-        x: sim.positions().iter().map(|x| x / l0).collect(),
-        v: sim.state.v.iter().map(|v| v / v0).collect(),
-        broken: sim
-            .field(JOINT_DAMAGE)
-            .unwrap()
-            .iter()
-            .filter(|&&d| d >= 1.0)
-            .count(),
-        kinetic: sim.kinetic_energy() / ke0,
-        time: sim.state.time * v0 / l0,
-        steps: sim.state.step,
-    }
+    finish(&mut sim, steps, v0, len(0.15))
 }
 
 #[test]
 fn three_d_si_and_mm_n_s_agree() {
-    let steps = 600;
-    let a = run_3d(Units::SI, steps, 0.0);
-    let b = run_3d(Units::MM_N_S, steps, 0.0);
-    let c = run_3d(Units::SI, steps, 1e-15);
-    let (dx, dv) = (rel(&a.x, &b.x), rel(&a.v, &b.v));
-    let (px, pv) = (rel(&a.x, &c.x), rel(&a.v, &c.v));
-    println!(
-        "3D: broken {} / {}, KE/KE0 {:.9} / {:.9}, |dx| {dx:.2e} ({px:.2e}), |dv| {dv:.2e} ({pv:.2e})",
-        a.broken, b.broken, a.kinetic, b.kinetic
-    );
-    assert_eq!(a.steps, b.steps);
-    assert!((a.time - b.time).abs() <= 1e-12 * a.time);
-    assert!(a.broken > 0, "the 3D scene must fracture");
-    assert_eq!(a.broken, b.broken, "broken joints differ");
-    assert!(dx <= (100.0 * px).max(1e-13), "positions differ by {dx:e}");
-    assert!(dv <= (100.0 * pv).max(1e-10), "velocities differ by {dv:e}");
+    compare_runs("3D", Units::MM_N_S, |u, eps| run_3d(u, 600, eps));
 }

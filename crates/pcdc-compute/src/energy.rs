@@ -198,6 +198,34 @@ impl EnergyBalance {
     }
 }
 
+/// Accumulated works (J): what each internal physics absorbed, the external work (of
+/// which the kinematic conditions' part) and the local damping.
+#[derive(Clone, Debug, Default)]
+struct Sums {
+    absorbed: Vec<f64>,
+    external: f64,
+    kinematic: f64,
+    local_damping: f64,
+}
+
+impl Sums {
+    /// Adds `sign` × one batch of works (per physics, then gravity, local damping and
+    /// kinematic conditions).
+    fn add(&mut self, works: &[f64], loads: &[bool], sign: f64) {
+        let n = loads.len();
+        for (p, (&w, &load)) in works[..n].iter().zip(loads).enumerate() {
+            if load {
+                self.external += sign * w;
+            } else {
+                self.absorbed[p] -= sign * w;
+            }
+        }
+        self.external += sign * (works[n] + works[n + 2]);
+        self.kinematic += sign * works[n + 2];
+        self.local_damping -= sign * works[n + 1];
+    }
+}
+
 /// The running accumulators (J).
 #[derive(Clone, Debug)]
 pub(crate) struct EnergyTracker {
@@ -205,16 +233,15 @@ pub(crate) struct EnergyTracker {
     pub tolerance: Option<f64>,
     /// Physics of each force slot.
     slot_phys: Vec<u32>,
+    /// Per physics: whether its forces are applied loads (external work).
+    loads: Vec<bool>,
     /// Velocity before this step's update.
     v_prev: Vec<f64>,
-    /// Per physics: energy absorbed (−work of its forces).
-    absorbed: Vec<f64>,
+    /// Works accumulated over all steps.
+    sums: Sums,
     /// Per physics: stored energy at the start (None until the first evaluation).
     stored_initial: Option<Vec<f64>>,
     initial: f64,
-    external: f64,
-    kinematic: f64,
-    local_damping: f64,
     /// Largest total energy seen at an evaluation.
     peak: f64,
     /// Inferred dissipation per physics at the previous evaluation.
@@ -222,13 +249,17 @@ pub(crate) struct EnergyTracker {
     /// Forward halves ½ Δt f · v⁺ of the last step's works (same layout as a batch of
     /// works): the part of the last step that lies beyond the state the stored energies
     /// describe.
-    pub forward: Vec<f64>,
+    forward: Vec<f64>,
     /// Last evaluated balance.
     pub last: Option<EnergyBalance>,
 }
 
 impl EnergyTracker {
-    pub fn new(tolerance: Option<f64>, slot_ranges: &[std::ops::Range<usize>]) -> Self {
+    pub fn new(
+        tolerance: Option<f64>,
+        slot_ranges: &[std::ops::Range<usize>],
+        loads: Vec<bool>,
+    ) -> Self {
         let n_slots = slot_ranges.last().map_or(0, |r| r.end);
         let mut slot_phys = vec![0u32; n_slots];
         for (p, r) in slot_ranges.iter().enumerate() {
@@ -238,65 +269,48 @@ impl EnergyTracker {
             tolerance,
             slot_phys,
             v_prev: Vec::new(),
-            absorbed: vec![0.0; slot_ranges.len()],
+            sums: Sums {
+                absorbed: vec![0.0; loads.len()],
+                ..Sums::default()
+            },
+            forward: vec![0.0; loads.len() + 3],
+            loads,
             stored_initial: None,
             initial: 0.0,
-            external: 0.0,
-            kinematic: 0.0,
-            local_damping: 0.0,
             peak: 0.0,
             dissipated_before: Vec::new(),
-            forward: Vec::new(),
             last: None,
         }
     }
 
-    /// Adds one batch of works (J): per physics (`works[..n]`), then gravity, local
-    /// damping and kinematic conditions; the same bookkeeping on both backends.
-    pub fn add_works(&mut self, works: &[f64], applies_loads: &[bool]) {
-        let n = applies_loads.len();
-        for (p, (&w, &load)) in works[..n].iter().zip(applies_loads).enumerate() {
-            if load {
-                self.external += w;
-            } else {
-                self.absorbed[p] -= w;
-            }
-        }
-        self.external += works[n] + works[n + 2];
-        self.kinematic += works[n + 2];
-        self.local_damping -= works[n + 1];
+    /// Adds one step's (CPU) or one run's (GPU) batch: the works (per physics, then
+    /// gravity, local damping and kinematic conditions), followed by the last step's
+    /// forward halves in the same layout; the same bookkeeping on both backends.
+    pub fn add_batch(&mut self, batch: &[f64]) {
+        let n = self.loads.len() + 3;
+        self.sums.add(&batch[..n], &self.loads, 1.0);
+        self.forward.copy_from_slice(&batch[n..2 * n]);
     }
 
-    /// The accumulated sums alone (for a corrected copy at a check).
-    fn clone_sums(&self) -> EnergyTracker {
-        EnergyTracker {
-            tolerance: None,
-            slot_phys: Vec::new(),
-            v_prev: Vec::new(),
-            absorbed: self.absorbed.clone(),
-            stored_initial: None,
-            initial: self.initial,
-            external: self.external,
-            kinematic: self.kinematic,
-            local_damping: self.local_damping,
-            peak: self.peak,
-            dissipated_before: Vec::new(),
-            forward: Vec::new(),
-            last: None,
-        }
+    /// The sums at the state the stored energies describe: the last step's forward
+    /// halves taken off.
+    fn sums_at_state(&self) -> Sums {
+        let mut s = self.sums.clone();
+        s.add(&self.forward, &self.loads, -1.0);
+        s
     }
 
     /// Restarts the balance from the current state (e.g. after static relaxation).
     pub fn rebase(&mut self) {
-        self.absorbed.fill(0.0);
+        self.sums = Sums {
+            absorbed: vec![0.0; self.loads.len()],
+            ..Sums::default()
+        };
         self.stored_initial = None;
         self.initial = 0.0;
-        self.external = 0.0;
-        self.kinematic = 0.0;
-        self.local_damping = 0.0;
         self.peak = 0.0;
         self.dissipated_before.clear();
-        self.forward.clear();
+        self.forward.fill(0.0);
         self.last = None;
     }
 }
@@ -351,10 +365,7 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
                 *a += b;
             }
         }
-        let loads: Vec<bool> = self.physics.iter().map(|p| p.applies_loads()).collect();
-        t.add_works(&sum[..n_phys + 3], &loads);
-        t.forward.clear();
-        t.forward.extend_from_slice(&sum[n_phys + 3..]);
+        t.add_batch(&sum);
         let verdict = if self.state.step % ENERGY_CHECK_EVERY == 0 {
             self.energy_check(&mut t)
         } else {
@@ -383,14 +394,8 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
         // every work and use the kinetic energy of time N, ½ m v⁻ · v⁺ = K(v⁺) − Σ of
         // the forward halves. With these, the balance of a linear elastic body is exact
         // (the leapfrog invariant), not only to O(ω Δt).
-        let np = self.physics.len();
-        let mut fwd = t.forward.clone();
-        fwd.resize(np + 3, 0.0);
-        let mut check = t.clone_sums();
-        let loads: Vec<bool> = self.physics.iter().map(|p| p.applies_loads()).collect();
-        let minus: Vec<f64> = fwd.iter().map(|x| -x).collect();
-        check.add_works(&minus, &loads);
-        let kinetic = self.kinetic_energy() - fwd.iter().sum::<f64>();
+        let check = t.sums_at_state();
+        let kinetic = self.kinetic_energy() - t.forward.iter().sum::<f64>();
         let balance = EnergyBalance {
             step: self.state.step,
             kinetic,
@@ -413,7 +418,7 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
         };
         let total = balance.total();
         t.peak = t.peak.max(total);
-        let reference = (t.initial + t.external).max(t.peak);
+        let reference = (t.initial + check.external).max(t.peak);
         let excess = balance.excess();
         // Dissipation gained since the previous evaluation, per physics: the injector is
         // the physics whose dissipation fell the most over the window in which the
@@ -427,7 +432,7 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
         };
         if reference > 0.0 && excess > tol * reference {
             let worst = (0..dissipated.len())
-                .filter(|&p| !self.physics[p].applies_loads())
+                .filter(|&p| !t.loads[p])
                 .map(|p| (p, dissipated[p] - previous.get(p).copied().unwrap_or(0.0)))
                 .filter(|&(_, gain)| gain < 0.0)
                 .min_by(|a, b| a.1.total_cmp(&b.1));

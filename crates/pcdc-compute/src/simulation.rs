@@ -241,8 +241,16 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             limit: None,
             damping: true,
             local_damping,
-            energy: energy.map(|tol| Box::new(EnergyTracker::new(tol, &layout.slot_ranges))),
+            energy: None,
         };
+        if let Some(tol) = energy {
+            let loads: Vec<bool> = sim.physics.iter().map(|p| p.applies_loads()).collect();
+            sim.energy = Some(Box::new(EnergyTracker::new(
+                tol,
+                &layout.slot_ranges,
+                loads,
+            )));
+        }
         sim.update_time_step()?;
         if let Some(gpu) = sim.backend.as_gpu().cloned() {
             sim.gpu = Some(Box::new(GpuRun::new(&gpu, &mut sim, &layout)?));

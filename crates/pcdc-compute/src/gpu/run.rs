@@ -646,11 +646,7 @@ impl GpuRun {
         if energy_on {
             let works = self.read_energy()?;
             if let Some(mut t) = sim.energy.take() {
-                let loads: Vec<bool> = sim.physics.iter().map(|p| p.applies_loads()).collect();
-                let np = loads.len() + 3;
-                t.add_works(&works[..np], &loads);
-                t.forward.clear();
-                t.forward.extend_from_slice(&works[np..]);
+                t.add_batch(&works);
                 let verdict = sim.energy_check(&mut t);
                 sim.energy = Some(t);
                 verdict?;
