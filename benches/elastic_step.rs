@@ -13,14 +13,14 @@
 //! elements/s (= element-steps/s).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use pcdc_compute::{Backend, CpuBackend, Precision, Simulation, WgpuBackend};
+use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim, Mesh, Range};
 
 /// Steps per measured GPU iteration.
 const GPU_STEPS: u64 = 20;
 
-fn sim<D: Dim, B: Backend>(mesh: Mesh<D>, backend: B, bottom: &str, top: &str) -> Simulation<D, B> {
+fn sim<D: Dim>(mesh: Mesh<D>, backend: Backend, bottom: &str, top: &str) -> Simulation<D> {
     let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
     let y = if D::D == 2 { 1 } else { 2 };
     let mut push = [None, None, None];
@@ -54,13 +54,13 @@ fn bench(c: &mut Criterion) {
     // 3D: cubes of 0.05/26 m, 6 tetrahedra each: 206 856 tetrahedra.
     let tet = builders::cuboid([0.0; 3], [0.05, 0.05, 0.0962], 0.05 / 26.0).unwrap();
     for &t in &threads {
-        let mut s2 = sim(tri.clone(), CpuBackend::new(t).unwrap(), "bottom", "top");
+        let mut s2 = sim(tri.clone(), Backend::cpu(t).unwrap(), "bottom", "top");
         g.throughput(Throughput::Elements(s2.mesh().n_elements() as u64));
         g.bench_function(
             format!("tri3_{}k_threads_{t}", s2.mesh().n_elements() / 1000),
             |b| b.iter(|| s2.step().unwrap()),
         );
-        let mut s3 = sim(tet.clone(), CpuBackend::new(t).unwrap(), "zmin", "zmax");
+        let mut s3 = sim(tet.clone(), Backend::cpu(t).unwrap(), "zmin", "zmax");
         g.throughput(Throughput::Elements(s3.mesh().n_elements() as u64));
         g.bench_function(
             format!("tet4_{}k_threads_{t}", s3.mesh().n_elements() / 1000),
@@ -68,14 +68,18 @@ fn bench(c: &mut Criterion) {
         );
     }
     for p in [Precision::F64, Precision::F32] {
-        let gpu = match WgpuBackend::new(Some(p)) {
+        let gpu = match Backend::gpu(Some(p)) {
             Ok(b) => b,
             Err(e) => {
                 eprintln!("no GPU rows in {}: {e}", p.name());
                 continue;
             }
         };
-        let name = if gpu.is_software() { "lavapipe" } else { "gpu" };
+        let name = if gpu.as_gpu().expect("a GPU backend").is_software() {
+            "lavapipe"
+        } else {
+            "gpu"
+        };
         g.throughput(Throughput::Elements(tri.n_elements() as u64 * GPU_STEPS));
         let mut s2 = sim(tri.clone(), gpu.clone(), "bottom", "top");
         let per = |b: Option<u64>, n: usize| b.unwrap_or(0) as f64 / n as f64;
@@ -84,7 +88,7 @@ fn bench(c: &mut Criterion) {
             name,
             p.name(),
             per(s2.gpu_bytes_per_step(), tri.n_elements()),
-            gpu.adapter_name()
+            gpu.as_gpu().expect("a GPU backend").adapter_name()
         );
         g.bench_function(
             format!("tri3_{}k_{name}_{}", tri.n_elements() / 1000, p.name()),

@@ -18,7 +18,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm};
-use pcdc_compute::{Backend, CpuBackend, Precision, Simulation, WgpuBackend};
+use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
@@ -28,11 +28,11 @@ const E: f64 = 30e9;
 /// Steps per measured GPU iteration.
 const GPU_STEPS: u64 = 20;
 
-fn scene<B: Backend>(cells_x: usize, backend: B) -> Simulation<Dim2, B> {
+fn scene(cells_x: usize, backend: Backend) -> Simulation<Dim2> {
     scene_with(cells_x, backend, false)
 }
 
-fn scene_with<B: Backend>(cells_x: usize, backend: B, contact: bool) -> Simulation<Dim2, B> {
+fn scene_with(cells_x: usize, backend: Backend, contact: bool) -> Simulation<Dim2> {
     let h = 0.05 / cells_x as f64;
     let mesh = builders::rectangle(0.0, 0.0, 0.05, 0.10, h).unwrap();
     let split = split_nodes(&mesh, &Range::All).unwrap();
@@ -75,7 +75,7 @@ fn bench(c: &mut Criterion) {
     // nx x 2nx cells of 2 triangles: 50 -> 10k, 112 -> 50k, 224 -> 201k.
     for nx in [50, 112, 224] {
         for &t in &threads {
-            let mut sim = scene(nx, CpuBackend::new(t).unwrap());
+            let mut sim = scene(nx, Backend::cpu(t).unwrap());
             let n = sim.mesh().n_elements();
             if t == 1 {
                 let joints = sim.field(pcdc_cohesive::JOINT_DAMAGE).unwrap().len();
@@ -90,7 +90,7 @@ fn bench(c: &mut Criterion) {
     // The full scene with contact (CPU).
     for nx in [50, 112] {
         for &t in &threads {
-            let mut sim = scene_with(nx, CpuBackend::new(t).unwrap(), true);
+            let mut sim = scene_with(nx, Backend::cpu(t).unwrap(), true);
             let n = sim.mesh().n_elements();
             if t == 1 {
                 // The candidate lists the contact physics builds (default skin: half the
@@ -112,15 +112,19 @@ fn bench(c: &mut Criterion) {
         }
     }
     for p in [Precision::F64, Precision::F32] {
-        let gpu = match WgpuBackend::new(Some(p)) {
+        let gpu = match Backend::gpu(Some(p)) {
             Ok(b) => b,
             Err(e) => {
                 eprintln!("no GPU rows in {}: {e}", p.name());
                 continue;
             }
         };
-        let name = if gpu.is_software() { "lavapipe" } else { "gpu" };
-        let sizes: &[usize] = if gpu.is_software() {
+        let name = if gpu.as_gpu().expect("a GPU backend").is_software() {
+            "lavapipe"
+        } else {
+            "gpu"
+        };
+        let sizes: &[usize] = if gpu.as_gpu().expect("a GPU backend").is_software() {
             &[50]
         } else {
             &[50, 112, 224]
@@ -132,7 +136,7 @@ fn bench(c: &mut Criterion) {
                 "fdem_step {name} {}: {n} triangles, {:.0} bytes per triangle-step, adapter {}",
                 p.name(),
                 sim.gpu_bytes_per_step().unwrap_or(0) as f64 / n as f64,
-                gpu.adapter_name()
+                gpu.as_gpu().expect("a GPU backend").adapter_name()
             );
             g.throughput(Throughput::Elements(n as u64 * GPU_STEPS));
             g.bench_function(

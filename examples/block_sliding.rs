@@ -10,26 +10,27 @@
 //! `PCDC_PRECISION`); the RESULT line carries `backend=` and `precision=`, e.g.
 //! `cargo run --release --example block_sliding -- --backend gpu --precision f32`.
 
-use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
-use pcdc::plot::Plot;
-use pcdc::report::{out_dir, ResultLine};
-use pcdc::scenes::block_sliding;
+mod common;
+
+const ABOUT: &str = "Validation scene 2: a block sliding with friction stops after v0² / (2 g tan φ), at four initial speeds (manual 7.3.4)";
+
+use pcdc::compute::Backend;
+use pcdc_validation::plot::Plot;
+use pcdc_validation::report::{out_dir, ResultLine};
+use pcdc_validation::scenes::block_sliding;
 
 fn main() {
-    pcdc::report::finish(choose())
+    pcdc_validation::report::finish(choose())
 }
 
 /// Runs the scene on the backend named on the command line.
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let choice = pcdc::report::backend_choice()?;
-    match choice.kind {
-        BackendKind::Cpu => run(&CpuBackend::new(0)?),
-        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
-    }
+    let args = common::cli::command("block_sliding", ABOUT).get_matches();
+    run(&common::cli::backend(&args)?)
 }
 
-fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    println!("backend: {}", pcdc::report::describe_backend(backend));
+fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", backend.describe());
     println!(
         "Block sliding on a fixed base, friction angle {} deg, g = 9.81 m/s^2",
         block_sliding::PHI

@@ -13,24 +13,23 @@
 
 mod common;
 
-use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
-use pcdc::report::{out_dir, ResultLine};
-use pcdc::scenes::brazilian;
+const ABOUT: &str = "The Brazilian (indirect tensile) test: a 50 mm rock disc (0.05 m) with a cohesive joint on every interior face, compressed along a diameter between two steel platens; plane strain, per unit thickness (t = 1 m)";
+
+use pcdc::compute::Backend;
+use pcdc_validation::report::{out_dir, ResultLine};
+use pcdc_validation::scenes::brazilian;
 
 fn main() {
-    pcdc::report::finish(choose())
+    pcdc_validation::report::finish(choose())
 }
 
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let choice = pcdc::report::backend_choice()?;
-    match choice.kind {
-        BackendKind::Cpu => run(&CpuBackend::new(0)?),
-        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
-    }
+    let args = common::cli::command("brazilian", ABOUT).get_matches();
+    run(&common::cli::backend(&args)?)
 }
 
-fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    println!("backend: {}", pcdc::report::describe_backend(backend));
+fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", backend.describe());
     let mut p = brazilian::Params::full();
     p.output.dir = out_dir("brazilian")?;
     Ok(vec![common::run_brazilian(backend, &p)?])

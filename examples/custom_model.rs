@@ -19,12 +19,18 @@
 //! elements round first, so f32 rounding picks a different crack path — a bifurcation,
 //! not an f32 bug; compare f32 runs with each other, not with the f64 CPU, after the peak.
 
+#[path = "common/cli.rs"]
+mod cli;
+
 use std::time::Instant;
 
-use pcdc::compute::{Backend, BackendKind, CpuBackend, Simulation, WgpuBackend};
+use pcdc::compute::{Backend, BackendKind, Simulation};
 use pcdc::mech::{double_dot, Boundary, ConstitutiveModel, Mechanics, Sym6, WgslModel};
 use pcdc::mesh::{builders, Range};
-use pcdc::report::{self, ResultLine};
+use pcdc_validation::report::{self, ResultLine};
+
+const ABOUT: &str =
+    "A user-defined constitutive model (damage elasticity) on both backends, CPU and GPU compared";
 
 /// Isotropic damage-elasticity with linear softening (one history variable: κ).
 #[derive(Clone, Debug)]
@@ -150,7 +156,7 @@ pub(crate) struct Run {
 }
 
 /// Runs the scene on `backend` (also called by `tests/custom_model.rs`).
-pub(crate) fn run<B: Backend>(backend: B) -> Result<Run, Box<dyn std::error::Error>> {
+pub(crate) fn run(backend: Backend) -> Result<Run, Box<dyn std::error::Error>> {
     let model = DamageElastic {
         young: 20e9,
         poisson: 0.2,
@@ -190,14 +196,15 @@ pub(crate) fn run<B: Backend>(backend: B) -> Result<Run, Box<dyn std::error::Err
 fn main() {
     report::finish(
         (|| -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-            let choice = report::backend_choice()?;
-            let cpu_backend = CpuBackend::new(0)?;
+            let args = cli::command("custom_model", ABOUT).get_matches();
+            let choice = cli::choice(&args)?;
+            let cpu_backend = Backend::cpu(0)?;
             let cpu = run(cpu_backend.clone())?;
             println!(
                 "cpu: {} elements, {} steps, {:.2} s, largest damage {:.3}",
                 cpu.elements, cpu.steps, cpu.wall_s, cpu.max_damage
             );
-            let gpu_backend = match (choice.kind, WgpuBackend::new(choice.precision)) {
+            let gpu_backend = match (choice.kind, Backend::gpu(choice.precision)) {
                 (_, Ok(b)) => b,
                 (BackendKind::Gpu, Err(e)) => return Err(e.into()),
                 (BackendKind::Cpu, Err(e)) => {
@@ -205,13 +212,16 @@ fn main() {
                     return Ok(vec![]);
                 }
             };
-            if choice.kind == BackendKind::Cpu && std::env::args().any(|a| a.contains("backend")) {
+            // `--backend cpu` given explicitly: the CPU run alone.
+            if choice.kind == BackendKind::Cpu
+                && args.value_source("backend") != Some(clap::parser::ValueSource::DefaultValue)
+            {
                 return Ok(vec![]);
             }
             let gpu = run(gpu_backend.clone())?;
             println!(
                 "gpu ({}, {}): {} steps, {:.2} s, largest damage {:.3}",
-                gpu_backend.adapter_name(),
+                gpu_backend.as_gpu().expect("a GPU backend").adapter_name(),
                 gpu_backend.precision(),
                 gpu.steps,
                 gpu.wall_s,

@@ -14,26 +14,27 @@
 //! Elements, joints and boundary conditions all run on the device; on lavapipe (software
 //! Vulkan) the full-size run is slow: it proves the path, not GPU speed.
 
-use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
-use pcdc::plot::Plot;
-use pcdc::report::{out_dir, ResultLine};
-use pcdc::scenes::direct_tension::{self as dt, Params};
+mod common;
+
+const ABOUT: &str = "Validation scene 7: direct tension of a dog-bone specimen with cohesive joints on every interior face (manual 7.4.3), at three mesh sizes";
+
+use pcdc::compute::Backend;
+use pcdc_validation::plot::Plot;
+use pcdc_validation::report::{out_dir, ResultLine};
+use pcdc_validation::scenes::direct_tension::{self as dt, Params};
 
 fn main() {
-    pcdc::report::finish(choose())
+    pcdc_validation::report::finish(choose())
 }
 
 /// Runs the scene on the backend named on the command line.
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let choice = pcdc::report::backend_choice()?;
-    match choice.kind {
-        BackendKind::Cpu => run(&CpuBackend::new(0)?),
-        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
-    }
+    let args = common::cli::command("direct_tension", ABOUT).get_matches();
+    run(&common::cli::backend(&args)?)
 }
 
-fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    println!("backend: {}", pcdc::report::describe_backend(backend));
+fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", backend.describe());
     let full = Params::full();
     println!("Direct tension, dog-bone 50 x 150 mm, neck 30 mm, arcs R = 150 mm; joints Ts = 2 MPa, c = 25 MPa, phi = 45 deg");
     println!(

@@ -11,26 +11,27 @@
 //! Backend: `--backend cpu|gpu` (default `cpu`, or `PCDC_BACKEND`) and, on the GPU,
 //! `--precision f64|f32` (`PCDC_PRECISION`).
 
-use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
-use pcdc::plot::Plot;
-use pcdc::report::{out_dir, ResultLine};
-use pcdc::scenes::fragmentation::{self, Params, ENERGY_TOL, PENETRATION_TOL};
+mod common;
+
+const ABOUT: &str = "Hard case: a jointed rock block thrown into a closed box shatters and its fragments fly, spin and collide for 100 000 steps (issue \"correctness first\")";
+
+use pcdc::compute::Backend;
+use pcdc_validation::plot::Plot;
+use pcdc_validation::report::{out_dir, ResultLine};
+use pcdc_validation::scenes::fragmentation::{self, Params, ENERGY_TOL, PENETRATION_TOL};
 
 fn main() {
-    pcdc::report::finish(choose())
+    pcdc_validation::report::finish(choose())
 }
 
 /// Runs the scene on the backend named on the command line.
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let choice = pcdc::report::backend_choice()?;
-    match choice.kind {
-        BackendKind::Cpu => run(&CpuBackend::new(0)?),
-        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
-    }
+    let args = common::cli::command("fragmentation", ABOUT).get_matches();
+    run(&common::cli::backend(&args)?)
 }
 
-fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    println!("backend: {}", pcdc::report::describe_backend(backend));
+fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", backend.describe());
     let p = Params::default();
     println!(
         "Jointed block (mesh {} m) thrown into a closed box: {} steps, checks every {}",

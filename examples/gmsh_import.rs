@@ -9,10 +9,11 @@
 //! tension. Physical groups of the file become node, element and face groups; export
 //! from Gmsh with `-format msh41` and `Mesh.Binary = 0`.
 
-use pcdc::compute::{CpuBackend, Simulation, StaticOptions};
+use clap::{Arg, Command};
+use pcdc::compute::{Backend, Simulation, StaticOptions};
 use pcdc::mech::{output, Boundary, FaceStress, LinearElastic, Mechanics};
 use pcdc::mesh::{gmsh, vtu::PvdSeries, Dim2, Range};
-use pcdc::report::out_dir;
+use pcdc_validation::report::out_dir;
 
 fn main() {
     if let Err(e) = run() {
@@ -22,22 +23,29 @@ fn main() {
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let path = args.first().cloned().unwrap_or_else(|| {
-        concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/crates/pcdc-mesh/tests/data/square.msh"
+    let args = Command::new("gmsh_import")
+        .about("Imports a 2D Gmsh mesh, holds one physical group, pulls another, solves statically and writes VTU")
+        .arg(
+            Arg::new("mesh")
+                .default_value(concat!(
+                    env!("CARGO_MANIFEST_DIR"),
+                    "/crates/pcdc-mesh/tests/data/square.msh"
+                ))
+                .help("MSH 4.1 ASCII file"),
         )
-        .to_string()
-    });
-    let fixed = args.get(1).cloned().unwrap_or_else(|| "left".into());
-    let loaded = args.get(2).cloned().unwrap_or_else(|| "right".into());
-    let stress: f64 = match args.get(3) {
-        Some(s) => s
-            .parse()
-            .map_err(|_| format!("stress '{s}' is not a number (Pa)"))?,
-        None => 1e6,
-    };
+        .arg(Arg::new("fixed").default_value("left").help("Physical group held fixed"))
+        .arg(Arg::new("loaded").default_value("right").help("Physical group pulled"))
+        .arg(
+            Arg::new("stress")
+                .default_value("1e6")
+                .value_parser(clap::value_parser!(f64))
+                .help("Normal stress on the loaded group (Pa, tension positive)"),
+        )
+        .get_matches();
+    let path = args.get_one::<String>("mesh").expect("default").clone();
+    let fixed = args.get_one::<String>("fixed").expect("default").clone();
+    let loaded = args.get_one::<String>("loaded").expect("default").clone();
+    let stress = *args.get_one::<f64>("stress").expect("default");
     let mesh = gmsh::read_msh::<Dim2>(&path)?;
     println!(
         "{path}: {} nodes, {} triangles",
@@ -54,7 +62,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let rock = LinearElastic::new(30e9, 0.25, 2600.0)?;
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(0)?)
+    let mut sim = Simulation::builder(mesh, Backend::cpu(0)?)
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(
             Boundary::new()

@@ -14,26 +14,27 @@
 //! `--backend gpu` only dynamic relaxation runs (on the device) and the example ends
 //! with its one RESULT line.
 
-use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
-use pcdc::plot::Plot;
-use pcdc::report::{out_dir, ResultLine};
-use pcdc::scenes::kirsch::{self, Params, Solver};
+mod common;
+
+const ABOUT: &str = "Validation scene 1 (Kirsch): a circular hole under far-field stress, solved by the direct sparse solve and by dynamic relaxation at three mesh sizes";
+
+use pcdc::compute::{Backend, BackendKind};
+use pcdc_validation::plot::Plot;
+use pcdc_validation::report::{out_dir, ResultLine};
+use pcdc_validation::scenes::kirsch::{self, Params, Solver};
 
 fn main() {
-    pcdc::report::finish(choose())
+    pcdc_validation::report::finish(choose())
 }
 
 /// Runs the scene on the backend named on the command line.
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let choice = pcdc::report::backend_choice()?;
-    match choice.kind {
-        BackendKind::Cpu => run(&CpuBackend::new(0)?),
-        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
-    }
+    let args = common::cli::command("kirsch", ABOUT).get_matches();
+    run(&common::cli::backend(&args)?)
 }
 
-fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    println!("backend: {}", pcdc::report::describe_backend(backend));
+fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", backend.describe());
     let full = Params::full();
     println!("Kirsch: hole radius a = {} m, ring to 25a, E = 50 GPa, nu = 0.25, P1 = 10 MPa (x), P2 = 5 MPa (y)", full.radius);
     println!(

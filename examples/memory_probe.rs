@@ -1,6 +1,6 @@
 //! Prints the element count and memory of the benchmark scenes (peak RSS from
 //! /proc/self/status and `Simulation::state_bytes`).
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Range};
 
@@ -16,11 +16,14 @@ fn peak_kb() -> u64 {
 }
 
 fn main() {
+    clap::Command::new("memory_probe")
+        .about("Prints the element count and memory of the benchmark scenes")
+        .get_matches();
     let base = peak_kb();
     let mesh = builders::rectangle(0.0, 0.0, 0.05, 0.10, 0.05 / 224.0).unwrap();
     let n = mesh.n_elements();
     let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(
             Boundary::new()

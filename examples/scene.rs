@@ -7,37 +7,37 @@
 
 mod common;
 
-use pcdc::compute::{Backend, BackendChoice, BackendKind, CpuBackend, WgpuBackend};
-use pcdc::report::{check_backend_args, ResultLine, BACKEND_USAGE};
-use pcdc::scenes::file::SceneFile;
+use pcdc::compute::Backend;
+use pcdc_validation::report::ResultLine;
+use pcdc_validation::scenes::file::SceneFile;
 
 fn main() {
-    pcdc::report::finish(choose())
+    pcdc_validation::report::finish(choose())
 }
 
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let mut args: Vec<String> = std::env::args().skip(1).collect();
-    let usage =
-        format!("usage: cargo run --release --example scene -- <scene.toml> [{BACKEND_USAGE}]");
-    if args.is_empty() || args[0].starts_with('-') {
-        return Err(usage.into());
-    }
-    let path = args.remove(0);
-    check_backend_args(&args)?;
-    let choice = BackendChoice::parse(&args)?;
-    let scene = SceneFile::read(&path).map_err(|e| format!("{path}: {e}"))?;
+    let args = common::cli::command(
+        "scene",
+        "Runs a scene file (TOML): the UCS or Brazilian test with your own parameters",
+    )
+    .arg(
+        clap::Arg::new("file")
+            .required(true)
+            .value_name("SCENE.toml")
+            .help("Scene file, e.g. scenes/ucs.toml or scenes/brazilian.toml"),
+    )
+    .get_matches();
+    let path = args.get_one::<String>("file").expect("required");
+    let scene = SceneFile::read(path).map_err(|e| format!("{path}: {e}"))?;
     println!("scene file: {path}");
-    match choice.kind {
-        BackendKind::Cpu => run(&CpuBackend::new(0)?, &scene),
-        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?, &scene),
-    }
+    run(&common::cli::backend(&args)?, &scene)
 }
 
-fn run<B: Backend>(
-    backend: &B,
+fn run(
+    backend: &Backend,
     scene: &SceneFile,
 ) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    println!("backend: {}", pcdc::report::describe_backend(backend));
+    println!("backend: {}", backend.describe());
     Ok(vec![match scene {
         SceneFile::Ucs(p) => common::run_ucs(backend, p)?,
         SceneFile::Brazilian(p) => common::run_brazilian(backend, p)?,

@@ -17,24 +17,23 @@
 
 mod common;
 
-use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
-use pcdc::report::{out_dir, ResultLine};
-use pcdc::scenes::ucs;
+const ABOUT: &str = "Validation scene 8, the UCS quick start of the manual (chapter 3): a 108 × 52 mm rock sample (0.108 × 0.052 m: the manual's millimetres in SI) with a cohesive joint on every interior face, crushed between two steel platens; plane strain";
+
+use pcdc::compute::Backend;
+use pcdc_validation::report::{out_dir, ResultLine};
+use pcdc_validation::scenes::ucs;
 
 fn main() {
-    pcdc::report::finish(choose())
+    pcdc_validation::report::finish(choose())
 }
 
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let choice = pcdc::report::backend_choice()?;
-    match choice.kind {
-        BackendKind::Cpu => run(&CpuBackend::new(0)?),
-        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
-    }
+    let args = common::cli::command("ucs", ABOUT).get_matches();
+    run(&common::cli::backend(&args)?)
 }
 
-fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    println!("backend: {}", pcdc::report::describe_backend(backend));
+fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", backend.describe());
     let mut p = ucs::Params::full();
     p.output.dir = out_dir("ucs")?;
     Ok(vec![common::run_ucs(backend, &p)?])

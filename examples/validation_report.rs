@@ -1,6 +1,6 @@
 //! The speed-against-error report: every validation scene at three mesh sizes on every
 //! backend and precision available; writes `docs/validation.md` and
-//! `docs/validation-error-vs-time.png` (see `pcdc::validation`).
+//! `docs/validation-error-vs-time.png` (see `pcdc_validation::table`).
 //!
 //! ```sh
 //! cargo run --release --example validation_report
@@ -17,7 +17,14 @@
 
 use std::io::Write;
 
-use pcdc::validation::{self, Row};
+use clap::builder::PossibleValuesParser;
+use clap::{Arg, ArgAction, Command};
+use pcdc::compute::{Backend, BackendKind};
+use pcdc_validation::table::{self, Row};
+
+fn is_gpu(b: &Backend) -> bool {
+    b.kind() == BackendKind::Gpu
+}
 
 fn main() {
     if let Err(e) = run() {
@@ -26,16 +33,7 @@ fn main() {
     }
 }
 
-fn list(args: &[String], flag: &str) -> Option<Vec<String>> {
-    let i = args.iter().position(|a| a == flag)?;
-    Some(
-        args.get(i + 1)
-            .map(|v| v.split(',').map(str::to_string).collect())
-            .unwrap_or_default(),
-    )
-}
-
-fn machine(backends: &[validation::AnyBackend]) -> String {
+fn machine(backends: &[Backend]) -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {
@@ -57,46 +55,54 @@ fn machine(backends: &[validation::AnyBackend]) -> String {
         ));
     }
     for b in backends {
-        if let validation::AnyBackend::Gpu(g) = b {
-            s.push_str(&format!("; {}: {}", b.label(), g.adapter_name()));
+        if let Some(g) = b.as_gpu() {
+            s.push_str(&format!(
+                "; {}: {}",
+                table::backend_label(b),
+                g.adapter_name()
+            ));
         }
     }
     s
 }
 
 fn run() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    for a in &args {
-        if a.starts_with("--") && !["--cases", "--backends", "--resume"].contains(&a.as_str()) {
-            return Err(format!("unknown option '{a}' (use --cases, --backends, --resume)").into());
-        }
-    }
-    let cases: Vec<String> = match list(&args, "--cases") {
-        Some(c) => c,
-        None => validation::CASES.iter().map(|c| c.to_string()).collect(),
+    let args = Command::new("validation_report")
+        .about("Every validation scene at three mesh sizes on every available backend: writes docs/validation.md and its plot")
+        .arg(
+            Arg::new("cases")
+                .long("cases")
+                .value_delimiter(',')
+                .value_parser(PossibleValuesParser::new(table::CASES))
+                .help("Only these scenes (default: all)"),
+        )
+        .arg(
+            Arg::new("backends")
+                .long("backends")
+                .value_delimiter(',')
+                .value_parser(["cpu", "gpu-f64", "gpu-f32"])
+                .help("Only these backends (default: all available)"),
+        )
+        .arg(
+            Arg::new("resume")
+                .long("resume")
+                .action(ArgAction::SetTrue)
+                .help("Keep the rows cached in out/validation/rows.csv and run only the missing ones"),
+        )
+        .get_matches();
+    let cases: Vec<String> = match args.get_many::<String>("cases") {
+        Some(c) => c.cloned().collect(),
+        None => table::CASES.iter().map(|c| c.to_string()).collect(),
     };
-    for c in &cases {
-        if !validation::CASES.contains(&c.as_str()) {
-            return Err(format!(
-                "unknown case '{c}' (cases: {})",
-                validation::CASES.join(", ")
-            )
-            .into());
-        }
+    let mut backends = table::available_backends();
+    if let Some(only) = args.get_many::<String>("backends") {
+        let only: Vec<String> = only.cloned().collect();
+        backends.retain(|b| only.contains(&table::backend_label(b)));
     }
-    let mut backends = validation::available_backends();
-    if let Some(only) = list(&args, "--backends") {
-        for o in &only {
-            if !["cpu", "gpu-f64", "gpu-f32"].contains(&o.as_str()) {
-                return Err(format!("unknown backend '{o}' (cpu, gpu-f64, gpu-f32)").into());
-            }
-        }
-        backends.retain(|b| only.contains(&b.label()));
-    }
-    let dir = pcdc::report::out_dir("validation")?;
+    let dir = pcdc_validation::report::out_dir("validation")?;
     let cache = dir.join("rows.csv");
     let mut rows: Vec<Row> = Vec::new();
-    if args.iter().any(|a| a == "--resume") {
+    if args.get_flag("resume") {
         if let Ok(text) = std::fs::read_to_string(&cache) {
             rows = text.lines().filter_map(Row::from_csv).collect();
         }
@@ -104,19 +110,21 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         std::fs::write(&cache, "")?;
     }
     println!("{} cached rows; backends: {}", rows.len(), {
-        let l: Vec<String> = backends.iter().map(|b| b.label()).collect();
+        let l: Vec<String> = backends.iter().map(table::backend_label).collect();
         l.join(", ")
     });
     for b in &backends {
         for case in &cases {
-            for job in validation::jobs(case, b.is_gpu()) {
+            for job in table::jobs(case, is_gpu(b)) {
                 let probe = Row {
                     case: job.case.into(),
                     variant: job.variant.into(),
                     size: job.mesh_size(),
                     elements: 0,
-                    backend: if b.is_gpu() { "gpu" } else { "cpu" }.into(),
-                    precision: b.label().trim_start_matches("gpu-").replace("cpu", "f64"),
+                    backend: b.kind().name().into(),
+                    precision: table::backend_label(b)
+                        .trim_start_matches("gpu-")
+                        .replace("cpu", "f64"),
                     error: 0.0,
                     tol: String::new(),
                     pass: false,
@@ -131,10 +139,10 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
                     job.case,
                     job.variant,
                     job.mesh_size(),
-                    b.label()
+                    table::backend_label(b)
                 );
                 std::io::stdout().flush()?;
-                match b.run(&job) {
+                match table::run_job(b, &job) {
                     Ok(row) => {
                         println!(
                             "{} elements, error {:.3e}, {} steps, {:.1} s{}",
@@ -155,23 +163,26 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     }
     // Jobs of every case on every available backend that have no row yet: say so.
     let mut missing = Vec::new();
-    for b in &validation::available_backends() {
-        for case in validation::CASES {
-            let n = validation::jobs(case, b.is_gpu()).len();
+    for b in &table::available_backends() {
+        for case in table::CASES {
+            let n = table::jobs(case, is_gpu(b)).len();
             let have = rows
                 .iter()
                 .filter(|r| {
                     r.case == *case
                         && format!("{}-{}", r.backend, r.precision)
-                            == b.label().replace("cpu", "cpu-f64")
+                            == table::backend_label(b).replace("cpu", "cpu-f64")
                 })
                 .count();
             if have < n {
-                missing.push(format!("{case} on {} ({have} of {n} rows)", b.label()));
+                missing.push(format!(
+                    "{case} on {} ({have} of {n} rows)",
+                    table::backend_label(b)
+                ));
             }
         }
     }
-    let mut md = validation::markdown(&rows, &machine(&backends));
+    let mut md = table::markdown(&rows, &machine(&backends));
     if !missing.is_empty() {
         md.push_str(&format!(
             "\nNot measured yet (run the command with `--resume` to add them): {}.\n",
@@ -180,7 +191,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     }
     std::fs::create_dir_all("docs")?;
     std::fs::write("docs/validation.md", md)?;
-    validation::plot(
+    table::plot(
         &rows,
         std::path::Path::new("docs/validation-error-vs-time.png"),
     )?;

@@ -9,26 +9,28 @@
 //! `PCDC_PRECISION`); the RESULT line carries `backend=` and `precision=`, e.g.
 //! `cargo run --release --example wave_speed -- --backend gpu --precision f32`.
 
-use pcdc::compute::{Backend, BackendKind, CpuBackend, WgpuBackend};
-use pcdc::plot::Plot;
-use pcdc::report::{out_dir, ResultLine};
-use pcdc::scenes::wave_speed::{self, Params};
+mod common;
+
+const ABOUT: &str =
+    "Validation scene 3: P-wave speed in a bar on rollers, 2D and 3D, three mesh sizes";
+
+use pcdc::compute::Backend;
+use pcdc_validation::plot::Plot;
+use pcdc_validation::report::{out_dir, ResultLine};
+use pcdc_validation::scenes::wave_speed::{self, Params};
 
 fn main() {
-    pcdc::report::finish(choose())
+    pcdc_validation::report::finish(choose())
 }
 
 /// Runs the scene on the backend named on the command line.
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let choice = pcdc::report::backend_choice()?;
-    match choice.kind {
-        BackendKind::Cpu => run(&CpuBackend::new(0)?),
-        BackendKind::Gpu => run(&WgpuBackend::new(choice.precision)?),
-    }
+    let args = common::cli::command("wave_speed", ABOUT).get_matches();
+    run(&common::cli::backend(&args)?)
 }
 
-fn run<B: Backend>(backend: &B) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    println!("backend: {}", pcdc::report::describe_backend(backend));
+fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    println!("backend: {}", backend.describe());
     let full = Params::full();
     println!(
         "P-wave speed, bar 1 m on rollers, E = 30 GPa, nu = 0.25, rho = 2600: c = {:.2} m/s",

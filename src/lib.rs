@@ -2,20 +2,21 @@
 //!
 //! Facade of the pcdc-rs SDK for continuum–discontinuum geomechanics by the combined
 //! finite–discrete element method (FDEM): re-exports the crates ([`mesh`], [`compute`],
-//! [`mech`]), holds the validation [`scenes`], their [`report`] lines and the PNG
-//! [`plot`]s.
+//! [`mech`], [`cohesive`], [`contact`]). The validation scenes, their RESULT lines,
+//! scene files and plots live in the separate crate `pcdc-validation`, so adding `pcdc`
+//! brings the SDK only. The cargo feature `gpu` (on by default) brings the GPU backend.
 //!
 //! A static scene in a few lines (the README's example):
 //!
 //! ```
-//! use pcdc::compute::{CpuBackend, Simulation, StaticOptions};
-//! use pcdc::mech::{output, Boundary, FaceStress, LinearElastic, Mechanics};
-//! use pcdc::mesh::{builders, Range};
+//! use pcdc::compute::{Backend, Simulation, StaticOptions};
+//! use pcdc::mech::{Boundary, FaceStress, LinearElastic, Mechanics, output};
+//! use pcdc::mesh::{Range, builders};
 //!
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let mesh = builders::rectangle(0.0, 0.0, 1.0, 2.0, 0.25)?;
 //! let rock = LinearElastic::new(30e9, 0.25, 2600.0)?.with_damping(1.0)?;
-//! let mut sim = Simulation::builder(mesh, CpuBackend::new(0)?)
+//! let mut sim = Simulation::builder(mesh, Backend::cpu(0)?)
 //!     .physics(Mechanics::new().material(Range::All, rock))
 //!     .physics(
 //!         Boundary::new()
@@ -40,8 +41,3 @@ pub use pcdc_compute as compute;
 pub use pcdc_contact as contact;
 pub use pcdc_mech as mech;
 pub use pcdc_mesh as mesh;
-
-pub mod plot;
-pub mod report;
-pub mod scenes;
-pub mod validation;

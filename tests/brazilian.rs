@@ -1,12 +1,12 @@
 //! Reduced-size Brazilian test: 4 mm mesh, platens at 0.04 m/s. The indirect tensile
 //! strength 2P/(πD) must lie within 0.7–1.5 T_s.
 
-use pcdc::compute::CpuBackend;
-use pcdc::scenes::brazilian;
+use pcdc::compute::Backend;
+use pcdc_validation::scenes::brazilian;
 
 #[test]
 fn reduced_brazilian_strength_within_band() {
-    let cpu = CpuBackend::new(2).unwrap();
+    let cpu = Backend::cpu(2).unwrap();
     let p = brazilian::Params::reduced();
     let out = brazilian::run(&cpu, &p, &mut |_| {}).unwrap();
     eprintln!(

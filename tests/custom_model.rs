@@ -7,11 +7,11 @@
 mod custom_model;
 
 use pcdc::compute::gpu::gpu_test_backend;
-use pcdc::compute::{CpuBackend, Precision};
+use pcdc::compute::{Backend, Precision};
 
 #[test]
 fn user_model_softens_and_matches_on_the_gpu() {
-    let cpu = custom_model::run(CpuBackend::new(2).unwrap()).unwrap();
+    let cpu = custom_model::run(Backend::cpu(2).unwrap()).unwrap();
     assert!(cpu.max_damage > 0.5, "largest damage {}", cpu.max_damage);
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;

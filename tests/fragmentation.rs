@@ -3,8 +3,8 @@
 //! energy plus the external work by more than 1 %, no node penetrates a foreign element
 //! by more than 5 % of its size, and no watchdog stops the run.
 
-use pcdc::compute::CpuBackend;
-use pcdc::scenes::fragmentation::{run, Params, ENERGY_TOL, PENETRATION_TOL};
+use pcdc::compute::Backend;
+use pcdc_validation::scenes::fragmentation::{run, Params, ENERGY_TOL, PENETRATION_TOL};
 
 #[test]
 fn fragments_in_a_box_stay_stable_for_100k_steps() {
@@ -13,7 +13,7 @@ fn fragments_in_a_box_stay_stable_for_100k_steps() {
         steps: 100_000,
         check_every: 1000,
     };
-    let o = run(&CpuBackend::new(0).unwrap(), &p).expect("no watchdog stop");
+    let o = run(&Backend::cpu(0).unwrap(), &p).expect("no watchdog stop");
     println!(
         "elements {}, dt {:.2e} s, broken {}/{}, worst excess {:.3e} at {}, penetration {:.3e}, {:.1} s",
         o.elements,

@@ -1,8 +1,8 @@
 //! Scene files: the shipped TOML files are the defaults, a scene survives a TOML round
 //! trip, and unknown keys and bad values are errors that name the key.
 
-use pcdc::scenes::file::{SceneFile, SceneFileError};
-use pcdc::scenes::{brazilian, ucs};
+use pcdc_validation::scenes::file::{SceneFile, SceneFileError};
+use pcdc_validation::scenes::{brazilian, ucs};
 
 fn shipped(name: &str) -> SceneFile {
     let path = format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"));

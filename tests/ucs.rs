@@ -3,12 +3,12 @@
 //! the closed-form modulus of the jointed sample within 2 %, UCS / T_s must lie in 5–20,
 //! and the peak must be a finite, positive strength after which the sample softens.
 
-use pcdc::compute::CpuBackend;
-use pcdc::scenes::ucs;
+use pcdc::compute::Backend;
+use pcdc_validation::scenes::ucs;
 
 #[test]
 fn reduced_ucs_modulus_within_tolerance_and_finite_peak() {
-    let cpu = CpuBackend::new(2).unwrap();
+    let cpu = Backend::cpu(2).unwrap();
     let p = ucs::Params::reduced();
     let out = ucs::run(&cpu, &p, &mut |_| {}).unwrap();
     eprintln!(
@@ -74,7 +74,7 @@ fn gpu_loading_branch_follows_the_cpu() {
     let mut p = ucs::Params::reduced();
     p.sample.mesh_size = 0.006;
     p.loading.max_closure = 3e-4;
-    let cpu = ucs::run(&CpuBackend::new(2).unwrap(), &p, &mut |_| {}).unwrap();
+    let cpu = ucs::run(&Backend::cpu(2).unwrap(), &p, &mut |_| {}).unwrap();
     let dev = ucs::run(&gpu, &p, &mut |_| {}).unwrap();
     assert_eq!(cpu.stress.len(), dev.stress.len());
     let top = cpu.stress.iter().fold(0.0f64, |m, s| m.max(s.abs()));

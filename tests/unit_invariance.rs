@@ -10,7 +10,7 @@
 //! manual eq. 59 corrected), the mm run slid differently from the SI run.
 
 use pcdc::cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE, JOINT_DAMAGE};
-use pcdc::compute::{CpuBackend, Simulation};
+use pcdc::compute::{Backend, Simulation};
 use pcdc::contact::Contact;
 use pcdc::mech::{Boundary, LinearElastic, Mechanics};
 use pcdc::mesh::{builders, Dim, Range};
@@ -102,7 +102,7 @@ fn run_perturbed(scale: f64, u: Units, steps: u64, eps: f64) -> Outcome {
         len(1.0),
         len(1.0),
     ));
-    let mut sim = Simulation::builder(split.mesh, CpuBackend::new(1).unwrap())
+    let mut sim = Simulation::builder(split.mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
         .physics(contact)
@@ -245,7 +245,7 @@ fn run_3d(u: Units, steps: u64, eps: f64) -> Outcome {
         .friction(30.0, 10.0 * e)
         .bonded_pairs(&split.joints.elements, &faces, BROKEN_FACE);
     let fixed = Range::cuboid([len(-1.0); 3], [len(1.0), len(1.0), len(0.0199)]);
-    let mut sim = Simulation::builder(split.mesh, CpuBackend::new(1).unwrap())
+    let mut sim = Simulation::builder(split.mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
         .physics(contact)

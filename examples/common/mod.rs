@@ -1,15 +1,17 @@
-//! Shared by the `ucs`, `brazilian` and `scene` examples: the progress bar and the runs.
+//! Shared by the examples: the command line ([`cli`]), the progress bar and the runs.
 
 // Each example uses only part of this module.
 #![allow(dead_code)]
+
+pub mod cli;
 
 use std::io::IsTerminal;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pcdc::compute::Backend;
-use pcdc::report::ResultLine;
-use pcdc::scenes::platen_test::Progress;
-use pcdc::scenes::{brazilian, ucs};
+use pcdc_validation::report::ResultLine;
+use pcdc_validation::scenes::platen_test::Progress;
+use pcdc_validation::scenes::{brazilian, ucs};
 
 /// A progress bar on stderr while stdout is a terminal, else a hidden one (no output in
 /// pipes, logs and CI).
@@ -34,8 +36,8 @@ fn update(bar: &ProgressBar, p: &Progress, msg: String) {
 }
 
 /// Runs the UCS scene with a progress bar and reports it.
-pub fn run_ucs<B: Backend>(
-    backend: &B,
+pub fn run_ucs(
+    backend: &Backend,
     p: &ucs::Params,
 ) -> Result<ResultLine, Box<dyn std::error::Error>> {
     let bar = progress_bar("ucs");
@@ -56,8 +58,8 @@ pub fn run_ucs<B: Backend>(
 }
 
 /// Runs the Brazilian scene with a progress bar and reports it.
-pub fn run_brazilian<B: Backend>(
-    backend: &B,
+pub fn run_brazilian(
+    backend: &Backend,
     p: &brazilian::Params,
 ) -> Result<ResultLine, Box<dyn std::error::Error>> {
     let bar = progress_bar("brazilian");

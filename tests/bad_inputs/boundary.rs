@@ -1,16 +1,16 @@
 //! Mechanical boundary conditions, checked when the simulation is built.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{set_velocity, Boundary, Constraint, FaceStress, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
 
 use crate::{case, run};
 
 /// A 2D elastic square with `bc`.
-fn sim(bc: Boundary) -> Result<Simulation<Dim2, CpuBackend>, pcdc_compute::ComputeError> {
+fn sim(bc: Boundary) -> Result<Simulation<Dim2>, pcdc_compute::ComputeError> {
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
     let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
-    Simulation::builder(mesh, CpuBackend::new(1)?)
+    Simulation::builder(mesh, Backend::cpu(1)?)
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(bc)
         .build()

@@ -2,7 +2,7 @@
 //! skin, the GPU candidate capacity and bonded pairs; each is an error naming the
 //! parameter when the simulation is built.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Range};
@@ -15,7 +15,7 @@ const E: f64 = 30e9;
 fn build(contact: Contact) -> Result<(), pcdc_compute::ComputeError> {
     let mesh = builders::rectangle(0.0, 0.0, 0.1, 0.05, 0.05).unwrap();
     let rock = LinearElastic::new(E, 0.25, 2600.0).unwrap();
-    Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+    Simulation::builder(mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(contact)
         .build()

@@ -1,6 +1,6 @@
 //! Linear elasticity: constructors, setters and deserialisation share one check.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{ConstitutiveModel, LinearElastic, Mechanics, Sym6};
 use pcdc_mesh::{builders, Range};
 
@@ -41,7 +41,7 @@ fn with_plugin(density: f64, modulus: f64, damping: f64) -> Result<(), pcdc_comp
         modulus,
         damping,
     };
-    Simulation::builder(mesh, CpuBackend::new(1)?)
+    Simulation::builder(mesh, Backend::cpu(1)?)
         .physics(Mechanics::new().material(Range::All, model))
         .build()
         .map(|_| ())

@@ -1,22 +1,26 @@
 //! Scene files (TOML): values out of range, physically absurd values, meshes over the
 //! memory limit, and malformed files.
 
-use pcdc::scenes::file::SceneFile;
+use pcdc_validation::scenes::file::SceneFile;
 
 use crate::{case, run};
 
-fn ucs(extra: &'static str) -> Result<SceneFile, pcdc::scenes::file::SceneFileError> {
+fn ucs(extra: &'static str) -> Result<SceneFile, pcdc_validation::scenes::file::SceneFileError> {
     SceneFile::from_toml(&format!("scene = \"ucs\"\n{extra}"))
 }
 
-fn brazilian(extra: &'static str) -> Result<SceneFile, pcdc::scenes::file::SceneFileError> {
+fn brazilian(
+    extra: &'static str,
+) -> Result<SceneFile, pcdc_validation::scenes::file::SceneFileError> {
     SceneFile::from_toml(&format!("scene = \"brazilian\"\n{extra}"))
 }
 
 const LOADING: &str =
     "stop_fraction = 0.7\nmax_closure = 0.005\nrecord_every = 100\nramp_time = 5e-5\n";
 
-fn loading(first: &'static str) -> Result<SceneFile, pcdc::scenes::file::SceneFileError> {
+fn loading(
+    first: &'static str,
+) -> Result<SceneFile, pcdc_validation::scenes::file::SceneFileError> {
     SceneFile::from_toml(&format!("scene = \"ucs\"\n[loading]\n{first}\n{LOADING}"))
 }
 

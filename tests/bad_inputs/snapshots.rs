@@ -5,7 +5,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use pcdc_compute::{CpuBackend, Simulation, Table};
+use pcdc_compute::{Backend, Simulation, Table};
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
 
@@ -22,7 +22,7 @@ fn block(x0: f64, young: f64, top: bool) -> Simulation<Dim2> {
         let vel = Table::new("top velocity", &[(0.0, 0.0), (1e-3, -0.05)]).unwrap();
         boundary = boundary.velocity(Range::group("top"), [None, Some(vel.into()), None]);
     }
-    Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+    Simulation::builder(mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(boundary)
         .gravity([0.0, -9.81, 0.0])
@@ -62,7 +62,7 @@ fn after_divergence() -> Vec<u8> {
         .with_damping(0.1)
         .unwrap();
     let vel = Table::new("top velocity", &[(0.0, 0.0), (1e-3, -0.05)]).unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(
             Boundary::new()
@@ -165,7 +165,7 @@ fn bad_snapshot_files_are_named_errors() {
     // A snapshot of a 3D scene restored into a 2D one names both dimensions.
     let cube = builders::cuboid([0.0; 3], [0.2; 3], 0.1).unwrap();
     let rock = LinearElastic::new(1e9, 0.25, 1000.0).unwrap();
-    let mut sim3 = Simulation::builder(cube, CpuBackend::new(1).unwrap())
+    let mut sim3 = Simulation::builder(cube, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .build()
         .unwrap();

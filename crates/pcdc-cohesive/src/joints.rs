@@ -26,7 +26,7 @@ use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
 use pcdc_compute::{
-    Backend, ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
+    ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
     Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
@@ -219,7 +219,7 @@ impl CohesiveJoints {
     }
 }
 
-impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
+impl<D: Dim> Physics<D> for CohesiveJoints {
     fn name(&self) -> &str {
         "cohesive joints"
     }
@@ -397,7 +397,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for CohesiveJoints {
         Some(format!("joint {}", slot / (2 * D::NODES_PER_FACE)))
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let [sid, did, bid] = self.ids.expect("init ran");
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let stride = self.state_stride();
@@ -524,7 +524,7 @@ mod gpu_tests {
     use super::*;
     use crate::{split_nodes, IntrinsicCzm, MohrCoulombJoint, Traction};
     use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
-    use pcdc_compute::{CpuBackend, Precision};
+    use pcdc_compute::Precision;
     use pcdc_mesh::builders;
 
     /// A joint model without a WGSL body (CPU only).
@@ -574,7 +574,7 @@ mod gpu_tests {
         let s2 = split_nodes(&m2, &Range::All).unwrap();
         let s3 = split_nodes(&m3, &Range::All).unwrap();
         for p in [Precision::F64, Precision::F32] {
-            let k2 = offline_kernel_sources::<_, CpuBackend>(
+            let k2 = offline_kernel_sources::<_>(
                 &s2.mesh,
                 vec![Box::new(joints(s2.joints.clone(), 3))],
                 p,
@@ -583,7 +583,7 @@ mod gpu_tests {
             let mut all = k2.clone();
             for g in [3, 7] {
                 all.extend(
-                    offline_kernel_sources::<_, CpuBackend>(
+                    offline_kernel_sources::<_>(
                         &s3.mesh,
                         vec![Box::new(joints(s3.joints.clone(), g))],
                         p,
@@ -611,8 +611,7 @@ mod gpu_tests {
     fn no_joints_no_kernel() {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
         let j = CohesiveJoints::new(Joints::default());
-        let k = offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(j)], Precision::F64)
-            .unwrap();
+        let k = offline_kernel_sources::<_>(&m2, vec![Box::new(j)], Precision::F64).unwrap();
         assert!(k.iter().all(|(l, _)| !l.starts_with("cohesive joints")));
     }
 
@@ -624,8 +623,7 @@ mod gpu_tests {
             .model(Range::All, czm())
             .model_for(vec![0], CpuOnly);
         let err =
-            offline_kernel_sources::<_, CpuBackend>(&s2.mesh, vec![Box::new(j)], Precision::F64)
-                .unwrap_err();
+            offline_kernel_sources::<_>(&s2.mesh, vec![Box::new(j)], Precision::F64).unwrap_err();
         assert!(matches!(err, ComputeError::NoGpuKernel { .. }), "{err:?}");
         let msg = err.to_string();
         assert!(

@@ -1,4 +1,4 @@
-//! CPU–GPU parity of the face-joints: one scene body, instantiated for `CpuBackend::new(1)`
+//! CPU–GPU parity of the face-joints: one scene body, instantiated for `Backend::cpu(1)`
 //! and the GPU backend (2D edge joints and 3D triangle-face joints with 3 and 7 Gauss
 //! points).
 //!
@@ -27,7 +27,7 @@ use pcdc_cohesive::{
     BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE,
 };
 use pcdc_compute::gpu::gpu_test_backend;
-use pcdc_compute::{Backend, CpuBackend, Precision, Simulation};
+use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh, Range};
 
@@ -93,7 +93,7 @@ struct Outcome {
 }
 
 /// The scene body, generic over the backend.
-fn run<D: Dim, B: Backend>(mesh: &Mesh<D>, backend: B, s: &Scene) -> Outcome {
+fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
     let split = split_nodes(mesh, &Range::All).unwrap();
     let (lo, hi) = mesh.bounding_box();
     let axis = D::D - 1;
@@ -185,17 +185,17 @@ fn parity<D: Dim>(name: &str, mesh: Mesh<D>, scene: Scene, precision: Precision,
     let Some(gpu) = gpu_test_backend(Some(precision)) else {
         return;
     };
-    let cpu = run(&mesh, CpuBackend::new(1).unwrap(), &scene);
+    let cpu = run(&mesh, Backend::cpu(1).unwrap(), &scene);
     let perturbed = Scene {
         perturb: 1e-15,
         ..scene.clone()
     };
-    let drift = run(&mesh, CpuBackend::new(1).unwrap(), &perturbed);
-    let reads = gpu.readbacks();
+    let drift = run(&mesh, Backend::cpu(1).unwrap(), &perturbed);
+    let reads = gpu.as_gpu().expect("a GPU backend").readbacks();
     let dev = run(&mesh, gpu.clone(), &scene);
     // One read-back for the whole run.
     assert_eq!(
-        gpu.readbacks() - reads,
+        gpu.as_gpu().expect("a GPU backend").readbacks() - reads,
         1,
         "device reads inside the step loop"
     );
@@ -221,7 +221,7 @@ fn parity<D: Dim>(name: &str, mesh: Mesh<D>, scene: Scene, precision: Precision,
          (relative to max) {ds:.3e}, broken faces that differ {flips}",
         D::NAME,
         precision.name(),
-        gpu.adapter_name(),
+        gpu.as_gpu().expect("a GPU backend").adapter_name(),
         scene.steps
     );
     assert!(softening > 0, "no joint is softening");
@@ -327,7 +327,7 @@ fn joint_forces_agree_to_rounding() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    fn forces<B: Backend>(backend: B, amp: f64) -> (Vec<f64>, Vec<f64>) {
+    fn forces(backend: Backend, amp: f64) -> (Vec<f64>, Vec<f64>) {
         let split = split_nodes(&bar_2d(), &Range::All).unwrap();
         let czm =
             IntrinsicCzm::new(30.0, 2e6, 1e6, 0.01, 0.1, 10.0 * E, 10.0 * E, 100.0 * E).unwrap();
@@ -345,7 +345,7 @@ fn joint_forces_agree_to_rounding() {
     }
     // From pre-peak (1e-9 m) to broken (1e-6 m) openings.
     for amp in [1e-9, 1e-8, 1e-7, 1e-6] {
-        let (a, da) = forces(CpuBackend::new(1).unwrap(), amp);
+        let (a, da) = forces(Backend::cpu(1).unwrap(), amp);
         let (b, db) = forces(gpu.clone(), amp);
         let exact = a.iter().zip(&b).filter(|(x, y)| x == y).count();
         let rel = max_diff(&a, &b) / max_abs(&a);

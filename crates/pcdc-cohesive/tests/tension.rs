@@ -2,7 +2,7 @@
 //! strength (2D and 3D), with results independent of the thread count.
 
 use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, JOINT_DAMAGE};
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim, Mesh, Range};
 
@@ -43,7 +43,7 @@ fn pull_with<D: Dim>(
         .unwrap()
         .with_damping(0.3)
         .unwrap();
-    let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(threads).unwrap())
+    let mut sim = Simulation::builder(split.mesh.clone(), Backend::cpu(threads).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(
             CohesiveJoints::new(split.joints.clone())
@@ -164,7 +164,7 @@ fn user_joint_model_plugs_in() {
         stiffness: k,
         break_opening: 1e6 / k,
     };
-    let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(1).unwrap())
+    let mut sim = Simulation::builder(split.mesh.clone(), Backend::cpu(1).unwrap())
         .physics(
             Mechanics::new().material(
                 Range::All,
@@ -200,7 +200,7 @@ fn user_joint_model_plugs_in() {
 fn undamped_joints_limit_the_time_step() {
     let mesh = builders::rectangle(0.0, 0.0, 0.02, 0.04, 0.005).unwrap();
     let split = split_nodes(&mesh, &Range::All).unwrap();
-    let sim = Simulation::builder(split.mesh, CpuBackend::new(1).unwrap())
+    let sim = Simulation::builder(split.mesh, Backend::cpu(1).unwrap())
         .physics(
             Mechanics::new().material(Range::All, LinearElastic::new(E, 0.25, 2600.0).unwrap()),
         )
@@ -241,7 +241,7 @@ fn a_pre_existing_fracture_carries_no_tension() {
         .unwrap()
         .with_damping(0.3)
         .unwrap();
-    let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(2).unwrap())
+    let mut sim = Simulation::builder(split.mesh.clone(), Backend::cpu(2).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(
             CohesiveJoints::new(split.joints.clone())

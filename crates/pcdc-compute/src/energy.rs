@@ -49,7 +49,7 @@ use pcdc_mesh::Dim;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::{Backend, ComputeError, Simulation};
+use crate::{ComputeError, Simulation};
 
 /// Steps between two evaluations of the stored energies (and of the watchdog).
 pub const ENERGY_CHECK_EVERY: u64 = 100;
@@ -315,7 +315,7 @@ impl EnergyTracker {
     }
 }
 
-impl<D: Dim, B: Backend> Simulation<D, B> {
+impl<D: Dim> Simulation<D> {
     /// Before the velocity update: keeps v⁻ and, on the first tracked step, the initial
     /// energies.
     pub(crate) fn energy_before_update(&mut self) {

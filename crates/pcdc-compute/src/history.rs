@@ -5,13 +5,13 @@ use std::path::Path;
 
 use pcdc_mesh::Dim;
 
-use crate::{Backend, ComputeError, Simulation};
+use crate::{ComputeError, Simulation};
 
 /// A user function sampled by [`Probe::Custom`].
-pub type ProbeFn<D, B> = Box<dyn Fn(&Simulation<D, B>) -> f64 + Send + Sync>;
+pub type ProbeFn<D> = Box<dyn Fn(&Simulation<D>) -> f64 + Send + Sync>;
 
 /// A quantity sampled by a [`History`].
-pub enum Probe<D: Dim, B: Backend> {
+pub enum Probe<D: Dim> {
     /// Simulation time (s).
     Time,
     /// Displacement component `comp` of node `node` (m).
@@ -42,16 +42,16 @@ pub enum Probe<D: Dim, B: Backend> {
     /// Stored (e.g. strain) energy (J).
     StoredEnergy,
     /// Any quantity computed from the simulation.
-    Custom(ProbeFn<D, B>),
+    Custom(ProbeFn<D>),
 }
 
 /// Probes sampled into columns, written as CSV (one header line, one row per sample).
-pub struct History<D: Dim, B: Backend> {
-    columns: Vec<(String, Probe<D, B>)>,
+pub struct History<D: Dim> {
+    columns: Vec<(String, Probe<D>)>,
     rows: Vec<Vec<f64>>,
 }
 
-impl<D: Dim, B: Backend> Default for History<D, B> {
+impl<D: Dim> Default for History<D> {
     fn default() -> Self {
         History {
             columns: Vec::new(),
@@ -60,20 +60,20 @@ impl<D: Dim, B: Backend> Default for History<D, B> {
     }
 }
 
-impl<D: Dim, B: Backend> History<D, B> {
+impl<D: Dim> History<D> {
     /// An empty history.
     pub fn new() -> Self {
         Self::default()
     }
 
     /// Adds a column.
-    pub fn probe(mut self, name: impl Into<String>, probe: Probe<D, B>) -> Self {
+    pub fn probe(mut self, name: impl Into<String>, probe: Probe<D>) -> Self {
         self.columns.push((name.into(), probe));
         self
     }
 
     /// Checks probes against the simulation (node and entity indices, field names).
-    pub fn validate(&self, sim: &Simulation<D, B>) -> Result<(), ComputeError> {
+    pub fn validate(&self, sim: &Simulation<D>) -> Result<(), ComputeError> {
         for (name, p) in &self.columns {
             match p {
                 Probe::NodeDisplacement { node, comp } | Probe::NodeVelocity { node, comp }
@@ -111,7 +111,7 @@ impl<D: Dim, B: Backend> History<D, B> {
     }
 
     /// Samples every probe now (the probes are checked at the first sample).
-    pub fn sample(&mut self, sim: &Simulation<D, B>) -> Result<(), ComputeError> {
+    pub fn sample(&mut self, sim: &Simulation<D>) -> Result<(), ComputeError> {
         if self.rows.is_empty() {
             self.validate(sim)?;
         }

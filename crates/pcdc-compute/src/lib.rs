@@ -1,8 +1,9 @@
 //! # pcdc-compute
 //!
-//! The engine of pcdc-rs: backends ([`CpuBackend`], rayon, deterministic for any thread
-//! count; [`WgpuBackend`], wgpu on a GPU with device-resident fields, f64 or f32 from one
-//! WGSL template, see [`gpu`]; [`BackendChoice`] picks one at run time), field storage that allocates only what the composed physics declare
+//! The engine of pcdc-rs: a run-time [`Backend`] (a CPU pool, rayon, deterministic for
+//! any thread count; or a GPU device, wgpu with device-resident fields, f64 or f32 from
+//! one WGSL template, see [`gpu`], behind the cargo feature `gpu`, on by default),
+//! field storage that allocates only what the composed physics declare
 //! ([`FieldStore`]), the [`Physics`] trait, the [`Simulation`] with explicit
 //! central-difference integration (manual 7.1 eq. i-v) with lumped mass and gravity, a
 //! stable time step with a safety factor and a report of the limiting entity, static
@@ -34,12 +35,13 @@ pub mod snapshot;
 mod statics;
 mod table;
 
-pub use backend::{Backend, BackendKind, CpuBackend};
+pub use backend::{Backend, BackendChoice, BackendKind, CpuBackend, Precision};
 pub use energy::{EnergyBalance, PhysicsEnergy, ENERGY_CHECK_EVERY};
 pub use error::ComputeError;
 pub use field::{names, FieldId, FieldSpec, FieldStore, Location};
 pub use fingerprint::Fingerprint;
-pub use gpu::{BackendChoice, Precision, WgpuBackend};
+#[cfg(feature = "gpu")]
+pub use gpu::WgpuBackend;
 pub use history::{History, Probe};
 pub use physics::{
     DofConstraint, ForceContext, InitContext, Kinematics, Physics, SlotBlock, StableStep,

@@ -8,7 +8,7 @@
 
 use pcdc_mesh::{Dim, Mesh};
 
-use crate::{Backend, ComputeError, CpuBackend, FieldSpec, FieldStore};
+use crate::{Backend, ComputeError, FieldSpec, FieldStore};
 
 /// Handle to a block of force slots registered by a physics.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,7 +90,7 @@ impl<D: Dim> InitContext<'_, D> {
 }
 
 /// Context given to [`Physics::compute_forces`].
-pub struct ForceContext<'a, D: Dim, B: Backend> {
+pub struct ForceContext<'a, D: Dim> {
     /// Kinematic state.
     pub kin: Kinematics<'a, D>,
     /// Field storage.
@@ -98,7 +98,7 @@ pub struct ForceContext<'a, D: Dim, B: Backend> {
     /// This physics' force slots (stride D), to be overwritten (they start zeroed).
     pub slots: &'a mut [f64],
     /// The backend.
-    pub backend: &'a B,
+    pub backend: &'a Backend,
 }
 
 /// Context given to [`Physics::apply_kinematics`] after the velocity update.
@@ -135,7 +135,7 @@ pub enum DofConstraint {
 }
 
 /// A physics on backend `B` in dimension `D`.
-pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
+pub trait Physics<D: Dim>: Send + Sync {
     /// Name used in reports and errors.
     fn name(&self) -> &str;
 
@@ -167,7 +167,7 @@ pub trait Physics<D: Dim, B: Backend = CpuBackend>: Send + Sync {
     }
 
     /// Computes this physics' forces into its slots (and updates its fields).
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError>;
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError>;
 
     /// Imposes prescribed velocities, accelerations and constraints on the freshly
     /// integrated velocities.

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use crate::energy::EnergyTracker;
 use crate::gpu::GpuRun;
 use crate::physics::{ForceContext, InitContext, Kinematics, VelocityContext};
-use crate::{Backend, ComputeError, CpuBackend, FieldStore, Physics, StableStep};
+use crate::{Backend, ComputeError, FieldStore, Physics, StableStep};
 
 /// Default safety factor applied to the critical time step.
 pub const DEFAULT_SAFETY: f64 = 0.5;
@@ -34,10 +34,10 @@ pub struct State {
 }
 
 /// Builds a [`Simulation`] from a mesh, a backend and the physics a scene composes.
-pub struct SimulationBuilder<D: Dim, B: Backend = CpuBackend> {
+pub struct SimulationBuilder<D: Dim> {
     mesh: Mesh<D>,
-    backend: B,
-    physics: Vec<Box<dyn Physics<D, B>>>,
+    backend: Backend,
+    physics: Vec<Box<dyn Physics<D>>>,
     gravity: [f64; 3],
     safety: f64,
     fixed_dt: Option<f64>,
@@ -46,12 +46,12 @@ pub struct SimulationBuilder<D: Dim, B: Backend = CpuBackend> {
     energy: Option<Option<f64>>,
 }
 
-impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
+impl<D: Dim> SimulationBuilder<D> {
     /// Starts a builder on `mesh` run by `backend`.
-    pub fn new(mesh: Mesh<D>, backend: B) -> Self {
+    pub fn new(mesh: Mesh<D>, backend: impl Into<Backend>) -> Self {
         SimulationBuilder {
             mesh,
-            backend,
+            backend: backend.into(),
             physics: Vec::new(),
             gravity: [0.0; 3],
             safety: DEFAULT_SAFETY,
@@ -86,13 +86,13 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
 
     /// Adds a physics. Physics run in the order they are added (this fixes the
     /// summation order of forces).
-    pub fn physics(mut self, p: impl Physics<D, B> + 'static) -> Self {
+    pub fn physics(mut self, p: impl Physics<D> + 'static) -> Self {
         self.physics.push(Box::new(p));
         self
     }
 
     /// Adds a boxed physics.
-    pub fn boxed_physics(mut self, p: Box<dyn Physics<D, B>>) -> Self {
+    pub fn boxed_physics(mut self, p: Box<dyn Physics<D>>) -> Self {
         self.physics.push(p);
         self
     }
@@ -132,7 +132,7 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
     }
 
     /// Declares fields, initialises every physics, lumps masses and picks the time step.
-    pub fn build(self) -> Result<Simulation<D, B>, ComputeError> {
+    pub fn build(self) -> Result<Simulation<D>, ComputeError> {
         let SimulationBuilder {
             mesh,
             backend,
@@ -252,6 +252,7 @@ impl<D: Dim, B: Backend> SimulationBuilder<D, B> {
             )));
         }
         sim.update_time_step()?;
+        #[cfg(feature = "gpu")]
         if let Some(gpu) = sim.backend.as_gpu().cloned() {
             sim.gpu = Some(Box::new(GpuRun::new(&gpu, &mut sim, &layout)?));
         }
@@ -270,9 +271,9 @@ pub(crate) struct Layout {
 
 /// Declares the fields of every physics, initialises them in order (registering their
 /// slots) and builds the CSR node -> slots lists (slots in registration order).
-pub(crate) fn prepare_layout<D: Dim, B: Backend>(
+pub(crate) fn prepare_layout<D: Dim>(
     mesh: &Mesh<D>,
-    physics: &mut [Box<dyn Physics<D, B>>],
+    physics: &mut [Box<dyn Physics<D>>],
 ) -> Result<Layout, ComputeError> {
     let n_nodes = mesh.n_nodes();
     let mut fields = FieldStore::default();
@@ -323,12 +324,12 @@ pub(crate) fn prepare_layout<D: Dim, B: Backend>(
 }
 
 /// A running simulation.
-pub struct Simulation<D: Dim, B: Backend = CpuBackend> {
+pub struct Simulation<D: Dim> {
     /// The evolving state.
     pub state: State,
     pub(crate) mesh: Mesh<D>,
-    pub(crate) backend: B,
-    pub(crate) physics: Vec<Box<dyn Physics<D, B>>>,
+    pub(crate) backend: Backend,
+    pub(crate) physics: Vec<Box<dyn Physics<D>>>,
     pub(crate) mass: Vec<f64>,
     pub(crate) mass_phys: Vec<f64>,
     pub(crate) force: Vec<f64>,
@@ -353,9 +354,9 @@ pub struct Simulation<D: Dim, B: Backend = CpuBackend> {
     pub(crate) energy: Option<Box<EnergyTracker>>,
 }
 
-impl<D: Dim, B: Backend> Simulation<D, B> {
-    /// Starts a builder on `backend` ([`CpuBackend`] or [`crate::WgpuBackend`]).
-    pub fn builder(mesh: Mesh<D>, backend: B) -> SimulationBuilder<D, B> {
+impl<D: Dim> Simulation<D> {
+    /// Starts a builder on `backend` (a [`Backend`], or a [`CpuBackend`] or GPU backend).
+    pub fn builder(mesh: Mesh<D>, backend: impl Into<Backend>) -> SimulationBuilder<D> {
         SimulationBuilder::new(mesh, backend)
     }
 
@@ -604,7 +605,7 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
     }
 }
 
-impl<D: Dim, B: Backend> Simulation<D, B> {
+impl<D: Dim> Simulation<D> {
     /// Read-only view of the current kinematic state (on the GPU backend: as read back at
     /// the end of the last run).
     pub fn kinematics(&self) -> Kinematics<'_, D> {
@@ -626,7 +627,7 @@ impl<D: Dim, B: Backend> Simulation<D, B> {
     }
 
     /// The backend.
-    pub fn backend(&self) -> &B {
+    pub fn backend(&self) -> &Backend {
         &self.backend
     }
 

@@ -51,7 +51,7 @@ use std::path::Path;
 use pcdc_mesh::Dim;
 use serde::{Deserialize, Serialize};
 
-use crate::{Backend, ComputeError, Fingerprint, Simulation, State};
+use crate::{ComputeError, Fingerprint, Simulation, State};
 
 /// Magic bytes at the start of every snapshot.
 pub const SNAPSHOT_MAGIC: [u8; 8] = *b"PCDCSNAP";
@@ -188,7 +188,7 @@ fn open(bytes: &[u8]) -> Result<&[u8], ComputeError> {
     Ok(payload)
 }
 
-impl<D: Dim, B: Backend> Simulation<D, B> {
+impl<D: Dim> Simulation<D> {
     /// Saves the running state to a file (format in the [`crate::snapshot`] module
     /// docs); see [`Simulation::restore`].
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), ComputeError> {

@@ -17,7 +17,7 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 
 use crate::physics::DofConstraint;
-use crate::{Backend, ComputeError, Simulation};
+use crate::{ComputeError, Simulation};
 use pcdc_mesh::Dim;
 
 /// Local damping coefficient used by dynamic relaxation.
@@ -53,7 +53,7 @@ pub struct StaticReport {
     pub ratio: f64,
 }
 
-impl<D: Dim, B: Backend> Simulation<D, B> {
+impl<D: Dim> Simulation<D> {
     /// Unbalanced-force ratio at the current state, ignoring constrained dofs.
     fn unbalanced_ratio(&mut self, free: &[bool]) -> Result<f64, ComputeError> {
         let gross = self.compute_forces(true)?.expect("gross requested");

@@ -11,7 +11,7 @@ mod common;
 
 use common::{boxes_at_rest, bvh_candidates};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use pcdc_compute::{Backend, CpuBackend};
+use pcdc_compute::Backend;
 use pcdc_contact::grid_candidates;
 use pcdc_mesh::builders;
 
@@ -30,7 +30,7 @@ fn bench(c: &mut Criterion) {
         let n = mesh.n_elements();
         g.throughput(Throughput::Elements(n as u64));
         for threads in [1, all] {
-            let pool = CpuBackend::new(threads).unwrap();
+            let pool = Backend::cpu(threads).unwrap();
             g.bench_function(format!("grid_{}k_threads_{threads}", n / 1000), |b| {
                 b.iter(|| pool.install(|| grid_candidates(&boxes, conn)))
             });

@@ -337,7 +337,7 @@ pub(crate) fn setup<D: Dim>(
 mod tests {
     use crate::{Contact, ContactModel, ContactStress};
     use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
-    use pcdc_compute::{ComputeError, CpuBackend, Physics, Precision};
+    use pcdc_compute::{ComputeError, Physics, Precision};
     use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh};
 
     fn two_blocks() -> Mesh<Dim2> {
@@ -353,14 +353,14 @@ mod tests {
     }
 
     fn sources(contact: Contact, p: Precision) -> Result<Vec<(String, String)>, ComputeError> {
-        let physics: Vec<Box<dyn Physics<Dim2, CpuBackend>>> = vec![Box::new(contact)];
+        let physics: Vec<Box<dyn Physics<Dim2>>> = vec![Box::new(contact)];
         offline_kernel_sources(&two_blocks(), physics, p)
     }
 
     /// Validates every contact kernel of `contact` on `mesh` with naga; checks that the
     /// forces kernel is the one of the mesh's dimension.
     fn validate_all<D: Dim>(mesh: &Mesh<D>, contact: Contact, p: Precision) {
-        let physics: Vec<Box<dyn Physics<D, CpuBackend>>> = vec![Box::new(contact)];
+        let physics: Vec<Box<dyn Physics<D>>> = vec![Box::new(contact)];
         let all = offline_kernel_sources(mesh, physics, p).unwrap();
         let ours: Vec<_> = all
             .iter()

@@ -38,7 +38,7 @@
 use std::sync::Mutex;
 
 use pcdc_compute::{
-    Backend, ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
+    ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
     Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh};
@@ -701,7 +701,7 @@ pub fn grid_candidates_3d(boxes: &[[f64; 6]], conn: &[u32]) -> Vec<Vec<u32>> {
         .collect()
 }
 
-impl<D: Dim, B: Backend> Physics<D, B> for Contact {
+impl<D: Dim> Physics<D> for Contact {
     fn name(&self) -> &str {
         "contact"
     }
@@ -865,7 +865,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Contact {
         })
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let rid = self.reference.expect("init ran");
         let ns = self.n_state;
         let kin = &ctx.kin;

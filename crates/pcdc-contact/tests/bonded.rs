@@ -2,7 +2,7 @@
 //! other until the bond's broken flag is set; then the pair pushes apart.
 
 use pcdc_compute::{
-    ComputeError, CpuBackend, FieldSpec, ForceContext, InitContext, Location, Physics, Simulation,
+    Backend, ComputeError, FieldSpec, ForceContext, InitContext, Location, Physics, Simulation,
 };
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
@@ -23,10 +23,7 @@ impl Physics<Dim2> for BondFlags {
     fn init(&mut self, _ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
         Ok(())
     }
-    fn compute_forces(
-        &self,
-        _ctx: &mut ForceContext<'_, Dim2, CpuBackend>,
-    ) -> Result<(), ComputeError> {
+    fn compute_forces(&self, _ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
         Ok(())
     }
 }
@@ -43,7 +40,7 @@ fn scene(contact: bool) -> (Simulation<Dim2>, u32) {
         })
         .unwrap();
     let rock = LinearElastic::new(1e9, 0.25, 1000.0).unwrap();
-    let mut b = Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+    let mut b = Simulation::builder(mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(BondFlags);
     if contact {
@@ -88,7 +85,7 @@ fn bad_bond_input_is_an_error() {
         (vec![0, 1, 1], vec![0], FLAG),
         (vec![0, 1], vec![0], "no_such_field"),
     ] {
-        let r = Simulation::builder(mesh.clone(), CpuBackend::new(1).unwrap())
+        let r = Simulation::builder(mesh.clone(), Backend::cpu(1).unwrap())
             .physics(Mechanics::new().material(Range::All, rock.clone()))
             .physics(BondFlags)
             .physics(Contact::new(1e10).bonded_pairs(&el, &fa, field))

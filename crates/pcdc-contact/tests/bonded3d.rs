@@ -2,7 +2,7 @@
 //! broken flag is set; then the pair pushes apart (the 3D form of tests/bonded.rs).
 
 use pcdc_compute::{
-    ComputeError, CpuBackend, FieldSpec, ForceContext, InitContext, Location, Physics, Simulation,
+    Backend, ComputeError, FieldSpec, ForceContext, InitContext, Location, Physics, Simulation,
 };
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
@@ -23,10 +23,7 @@ impl Physics<Dim3> for BondFlags {
     fn init(&mut self, _ctx: &mut InitContext<'_, Dim3>) -> Result<(), ComputeError> {
         Ok(())
     }
-    fn compute_forces(
-        &self,
-        _ctx: &mut ForceContext<'_, Dim3, CpuBackend>,
-    ) -> Result<(), ComputeError> {
+    fn compute_forces(&self, _ctx: &mut ForceContext<'_, Dim3>) -> Result<(), ComputeError> {
         Ok(())
     }
 }
@@ -47,7 +44,7 @@ fn scene(contact: bool) -> (Simulation<Dim3>, u32) {
         })
         .unwrap();
     let rock = LinearElastic::new(1e9, 0.25, 1000.0).unwrap();
-    let mut b = Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+    let mut b = Simulation::builder(mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(BondFlags);
     if contact {

@@ -4,7 +4,7 @@
 //! to rounding, energy does not grow, and no node sinks deeper than 1 % of the element
 //! size into another fragment at any sampled time.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
@@ -54,7 +54,7 @@ fn spinning_fragments_stay_stable_and_apart() {
     }
     let (mesh, bodies) = builders::union(&blocks.iter().collect::<Vec<_>>()).unwrap();
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(2).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(2).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(Contact::new(100.0 * E))
         .build()

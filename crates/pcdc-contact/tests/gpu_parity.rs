@@ -1,5 +1,5 @@
 //! CPU–GPU parity of the contact physics (2D and 3D): one scene body, instantiated for
-//! `CpuBackend::new(1)` and the GPU backend.
+//! `Backend::cpu(1)` and the GPU backend.
 //!
 //! Scenes: (1) two elastic blocks collide obliquely, one spinning, with Coulomb friction
 //! (the stick and slip branches run) and contact damping (loading cap and unloading
@@ -20,7 +20,7 @@
 
 use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE};
 use pcdc_compute::gpu::gpu_test_backend;
-use pcdc_compute::{Backend, CpuBackend, Precision, Simulation};
+use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_contact::{Contact, CONTACT_REFERENCE};
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Dim3, Mesh, Range};
@@ -42,7 +42,7 @@ struct Outcome {
 }
 
 /// Scene 1: oblique, spinning, frictional and damped impact.
-fn impact<B: Backend>(backend: B) -> Outcome {
+fn impact(backend: Backend) -> Outcome {
     let mesh = two_blocks(0.002);
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
     let contact = Contact::new(10.0 * E)
@@ -74,7 +74,7 @@ fn impact<B: Backend>(backend: B) -> Outcome {
 }
 
 /// Scene 2: an FDEM block with bonded pairs hits a second block; joints break.
-fn fdem<B: Backend>(backend: B, perturb: f64) -> Outcome {
+fn fdem(backend: Backend, perturb: f64) -> Outcome {
     let a = builders::rectangle(0.0, 0.0, 0.06, 0.06, 0.01).unwrap();
     let b = builders::rectangle(0.061, -0.02, 0.04, 0.1, 0.01).unwrap();
     let mesh = builders::union(&[&a, &b]).unwrap().0;
@@ -122,11 +122,7 @@ fn fdem<B: Backend>(backend: B, perturb: f64) -> Outcome {
 /// after each call (exact for `chunk` = 1). `surface`: the law is element-surface
 /// contact (table 1) with friction and penalty varying by element instead. Returns the
 /// outcome, the builds counted and the mean velocity of the struck block.
-fn impact_3d<B: Backend>(
-    backend: B,
-    chunk: Option<u64>,
-    surface: bool,
-) -> (Outcome, usize, [f64; 3]) {
+fn impact_3d(backend: Backend, chunk: Option<u64>, surface: bool) -> (Outcome, usize, [f64; 3]) {
     let a = builders::cuboid([0.0; 3], [0.04; 3], 0.02).unwrap();
     let b = builders::cuboid([0.0401, 0.012, 0.007], [0.04; 3], 0.02).unwrap();
     let (mesh, bodies) = builders::union(&[&a, &b]).unwrap();
@@ -142,7 +138,7 @@ fn impact_3d<B: Backend>(
             .damping(2e6, 2.0)
     };
     let contact = contact.skin(2e-4);
-    let mut sim: Simulation<Dim3, B> = Simulation::builder(mesh, backend)
+    let mut sim: Simulation<Dim3> = Simulation::builder(mesh, backend)
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(contact)
         .build()
@@ -229,11 +225,11 @@ fn frictional_damped_impact_matches_cpu_f64() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    let cpu = impact(CpuBackend::new(1).unwrap());
-    let reads = gpu.readbacks();
+    let cpu = impact(Backend::cpu(1).unwrap());
+    let reads = gpu.as_gpu().expect("a GPU backend").readbacks();
     let dev = impact(gpu.clone());
     // One read-back per run() call.
-    assert_eq!(gpu.readbacks() - reads, 2);
+    assert_eq!(gpu.as_gpu().expect("a GPU backend").readbacks() - reads, 2);
     compare("impact f64", &cpu, &dev, (1e-12, 1e-11));
 }
 
@@ -242,14 +238,14 @@ fn fdem_block_breaking_on_impact_matches_cpu_f64() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    let cpu = fdem(CpuBackend::new(1).unwrap(), 0.0);
+    let cpu = fdem(Backend::cpu(1).unwrap(), 0.0);
     assert!(
         cpu.broken > 0,
         "no joint broke: the scene does not test bonded pairs"
     );
     // Fracture amplifies rounding: the CPU itself, with the initial velocities perturbed
     // by 1e-15 (relative), drifts this far; the bar is four times that drift.
-    let perturbed = fdem(CpuBackend::new(1).unwrap(), 1e-15);
+    let perturbed = fdem(Backend::cpu(1).unwrap(), 1e-15);
     let drift_u = max_diff(&cpu.u, &perturbed.u) / max_abs(&cpu.u);
     let drift_v = max_diff(&cpu.v, &perturbed.v) / max_abs(&cpu.v);
     println!("fdem: CPU drift under a 1e-15 perturbation: u {drift_u:.2e}, v {drift_v:.2e}");
@@ -268,7 +264,7 @@ fn impact_f32_is_close() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F32)) else {
         return;
     };
-    let cpu = impact(CpuBackend::new(1).unwrap());
+    let cpu = impact(Backend::cpu(1).unwrap());
     let dev = impact(gpu);
     // Measured and printed; bounded loosely (single precision, a frictional impact).
     compare("impact f32", &cpu, &dev, (2e-2, 2e-2));
@@ -295,9 +291,9 @@ fn tet_blocks_frictional_damped_impact_matches_cpu_f64() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    let (cpu, _, struck) = impact_3d(CpuBackend::new(1).unwrap(), None, false);
+    let (cpu, _, struck) = impact_3d(Backend::cpu(1).unwrap(), None, false);
     // The same run step by step on the CPU: the scene does rebuild the lists during it.
-    let (stepped, builds, _) = impact_3d(CpuBackend::new(1).unwrap(), Some(1), false);
+    let (stepped, builds, _) = impact_3d(Backend::cpu(1).unwrap(), Some(1), false);
     assert_eq!(stepped.u, cpu.u, "the CPU depends on how the run is split");
     println!("impact 3d: {builds} broad-phase builds, struck block at {struck:.3?} m/s");
     // The blocks did collide, and friction dragged the struck block sideways.
@@ -307,9 +303,9 @@ fn tet_blocks_frictional_damped_impact_matches_cpu_f64() {
         builds >= 4,
         "only {builds} broad-phase builds: raise the speed or lower the skin"
     );
-    let reads = gpu.readbacks();
+    let reads = gpu.as_gpu().expect("a GPU backend").readbacks();
     let (dev, _, _) = impact_3d(gpu.clone(), None, false);
-    assert_eq!(gpu.readbacks() - reads, 2);
+    assert_eq!(gpu.as_gpu().expect("a GPU backend").readbacks() - reads, 2);
     compare("impact 3d f64", &cpu, &dev, (1e-12, 1e-11));
 }
 
@@ -318,7 +314,7 @@ fn tet_blocks_impact_f32_is_close() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F32)) else {
         return;
     };
-    let (cpu, _, _) = impact_3d(CpuBackend::new(1).unwrap(), None, false);
+    let (cpu, _, _) = impact_3d(Backend::cpu(1).unwrap(), None, false);
     let (dev, _, _) = impact_3d(gpu, None, false);
     // Measured and printed; bounded loosely (single precision, a frictional impact).
     compare("impact 3d f32", &cpu, &dev, (2e-2, 2e-2));
@@ -331,7 +327,7 @@ fn tet_blocks_surface_contact_matches_cpu_f64() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    let (cpu, _, struck) = impact_3d(CpuBackend::new(1).unwrap(), None, true);
+    let (cpu, _, struck) = impact_3d(Backend::cpu(1).unwrap(), None, true);
     println!("surface contact 3d: struck block at {struck:.3?} m/s");
     assert!(struck[0] > 0.3, "no impact: {struck:?}");
     let (dev, _, _) = impact_3d(gpu, None, true);

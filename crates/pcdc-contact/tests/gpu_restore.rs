@@ -6,13 +6,13 @@
 //! Without a GPU adapter the test skips (and fails with PCDC_REQUIRE_GPU=1).
 
 use pcdc_compute::gpu::gpu_test_backend;
-use pcdc_compute::{Precision, Simulation, WgpuBackend};
+use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
 
 /// Two elastic blocks 2 mm apart, the left one moving at 2 m/s towards the right one.
-fn impact(gpu: &WgpuBackend) -> Simulation<Dim2, WgpuBackend> {
+fn impact(gpu: &Backend) -> Simulation<Dim2> {
     let a = builders::rectangle(0.0, 0.0, 0.1, 0.1, 0.02).unwrap();
     let b = builders::rectangle(0.102, 0.03, 0.1, 0.1, 0.02).unwrap();
     let mesh = builders::union(&[&a, &b]).unwrap().0;

@@ -1,7 +1,7 @@
 //! Two elastic blocks collide head-on without friction or damping: linear momentum is
 //! conserved to rounding and the energy comes back after separation.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Mesh, Range};
@@ -22,7 +22,7 @@ fn run(threads: usize) -> (Simulation<Dim2>, f64, f64, f64) {
 fn run_with(threads: usize, contact: Contact) -> (Simulation<Dim2>, f64, f64, f64) {
     let mesh = two_blocks();
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(threads).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(threads).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(contact)
         .build()
@@ -120,7 +120,7 @@ fn contact_damping_parameters_are_checked() {
     let mesh = two_blocks();
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
     for (t, b) in [(-1.0, 2.0), (1e6, 0.5), (1e6, f64::NAN)] {
-        let r = Simulation::builder(mesh.clone(), CpuBackend::new(1).unwrap())
+        let r = Simulation::builder(mesh.clone(), Backend::cpu(1).unwrap())
             .physics(Mechanics::new().material(Range::All, rock.clone()))
             .physics(Contact::new(10.0 * E).damping(t, b))
             .build();
@@ -170,7 +170,7 @@ fn user_contact_model_plugs_in() {
 fn a_stiff_friction_spring_lowers_the_contact_time_step() {
     let limit = |contact: Contact| {
         let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
-        let sim = Simulation::builder(two_blocks(), CpuBackend::new(1).unwrap())
+        let sim = Simulation::builder(two_blocks(), Backend::cpu(1).unwrap())
             .physics(Mechanics::new().material(Range::All, rock))
             .physics(contact)
             .build()

@@ -2,7 +2,7 @@
 //! momentum is conserved to rounding, the energy comes back after separation and the
 //! bodies barely interpenetrate.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim3, Mesh};
@@ -45,7 +45,7 @@ fn momentum(s: &Simulation<Dim3>) -> [f64; 3] {
 fn run(threads: usize) -> Outcome {
     let (mesh, bodies) = two_cubes();
     let rock = LinearElastic::new(E, 0.25, RHO).unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(threads).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(threads).unwrap())
         .physics(Mechanics::new().material(pcdc_mesh::Range::All, rock))
         .physics(Contact::new(10.0 * E))
         .build()
@@ -159,7 +159,7 @@ fn stable_step_3d_holds_at_safety_factor_one() {
     }
     let mesh = Mesh::<Dim3>::new(coords, conn).unwrap();
     let rock = LinearElastic::new(E, 0.25, RHO).unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(2).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(2).unwrap())
         .physics(Mechanics::new().material(pcdc_mesh::Range::All, rock))
         .physics(Contact::new(100.0 * E))
         .safety_factor(1.0)

@@ -1,7 +1,7 @@
 //! Save/restore of a frictional contact scene continues bit for bit: the candidate lists
 //! and accumulated slips travel with the snapshot.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
@@ -15,7 +15,7 @@ fn scene() -> Simulation<Dim2> {
         .unwrap()
         .with_damping(1.0)
         .unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(2).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(2).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(Contact::new(1e9).friction(30.0, 1e9))
         .physics(Boundary::new().fix(Range::rect(-1.0, -1.0, 1.0, 0.05 - 1e-9)))

@@ -2,7 +2,7 @@
 //! d = v0² / (2 g tan φ) (manual eq. 62, the 3D form of validation scene 2), and a
 //! snapshot of the sliding block restores bit for bit.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim3, Range};
@@ -26,7 +26,7 @@ fn scene(v0: f64, threads: usize) -> (Simulation<Dim3>, Vec<u32>) {
         .unwrap()
         .with_damping(1.0)
         .unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(threads).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(threads).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(Contact::new(10.0 * E).friction(PHI, 10.0 * E))
         .physics(Boundary::new().fix(Range::cuboid(

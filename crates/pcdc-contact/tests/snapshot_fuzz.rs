@@ -12,7 +12,7 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE};
-use pcdc_compute::{ComputeError, CpuBackend, Simulation};
+use pcdc_compute::{Backend, ComputeError, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
@@ -32,7 +32,7 @@ fn fdem(x_struck: f64, friction: f64) -> Simulation<Dim2> {
         .friction(friction, 10.0 * E)
         .bonded_pairs(&split.joints.elements, &bond_faces, BROKEN_FACE);
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
-    let mut sim = Simulation::builder(split.mesh.clone(), CpuBackend::new(1).unwrap())
+    let mut sim = Simulation::builder(split.mesh.clone(), Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(CohesiveJoints::new(split.joints.clone()).model(Range::All, czm))
         .physics(contact)
@@ -219,7 +219,7 @@ fn foreign_fracturing_snapshots_are_refused() {
     // Another composition: no contact.
     let mesh = a.mesh().clone();
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
-    let mut plain = Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+    let mut plain = Simulation::builder(mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .build()
         .unwrap();

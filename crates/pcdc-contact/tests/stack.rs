@@ -1,7 +1,7 @@
 //! Hard case: a stack of three blocks dropped onto a fixed base under gravity comes to
 //! rest, with the interpenetration bounded by the penalty.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Mesh, Range};
@@ -35,7 +35,7 @@ fn stack_settles_under_gravity() {
         .unwrap()
         .with_damping(1.0)
         .unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(2).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(2).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(Contact::new(100.0 * E).friction(30.0, 100.0 * E))
         .physics(Boundary::new().fix(Range::rect(-1.0, -1.0, 1.0, 0.05 - 1e-9)))

@@ -3,7 +3,7 @@
 //! the default penalty 10 E moves exactly as with the explicit `contact-m-c` law of the
 //! same parameters, and two materials combine by the smaller value.
 
-use pcdc_compute::{CpuBackend, Simulation};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Mesh, Range};
@@ -19,7 +19,7 @@ fn block_on_base() -> Mesh<Dim2> {
 
 /// Slides the block at 1 m/s for 2000 steps; returns the displacement field.
 fn slide(mech: Mechanics, contact: Contact) -> Vec<f64> {
-    let mut sim = Simulation::builder(block_on_base(), CpuBackend::new(1).unwrap())
+    let mut sim = Simulation::builder(block_on_base(), Backend::cpu(1).unwrap())
         .physics(mech)
         .physics(contact)
         .physics(Boundary::new().fix(Range::rect(-1.0, -1.0, 1e3, BASE_TOP - 1e-9)))
@@ -86,7 +86,7 @@ fn two_surfaces_take_the_smaller_friction() {
 #[test]
 fn bad_surface_data_is_an_error() {
     let mech = Mechanics::new().material(Range::All, rock(30.0));
-    let err = Simulation::builder(block_on_base(), CpuBackend::new(1).unwrap())
+    let err = Simulation::builder(block_on_base(), Backend::cpu(1).unwrap())
         .physics(mech)
         .physics(Contact::new(1.0).surface_defaults(vec![30.0; 3], vec![1e9; 3]))
         .build()

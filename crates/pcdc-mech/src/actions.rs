@@ -1,7 +1,7 @@
 //! Resets between stages (manual 7.2.8): node velocity, node displacement and element
 //! state. Also used to give nodes an initial velocity.
 
-use pcdc_compute::{names, Backend, Simulation};
+use pcdc_compute::{names, Simulation};
 use pcdc_mesh::{Dim, Range};
 
 use crate::MechError;
@@ -11,8 +11,8 @@ pub const DISPLACEMENT_RESET: &str = "displacement_reset";
 
 /// Sets the velocity (m/s) of every node in `range` (first `D` components used; on a 2D
 /// mesh a non-zero z component is an error, as it would be ignored).
-pub fn set_velocity<D: Dim, B: Backend>(
-    sim: &mut Simulation<D, B>,
+pub fn set_velocity<D: Dim>(
+    sim: &mut Simulation<D>,
     range: &Range,
     velocity: [f64; 3],
 ) -> Result<usize, MechError> {
@@ -39,18 +39,15 @@ pub fn set_velocity<D: Dim, B: Backend>(
 }
 
 /// Zeroes the velocity of every node in `range`.
-pub fn reset_velocity<D: Dim, B: Backend>(
-    sim: &mut Simulation<D, B>,
-    range: &Range,
-) -> Result<usize, MechError> {
+pub fn reset_velocity<D: Dim>(sim: &mut Simulation<D>, range: &Range) -> Result<usize, MechError> {
     set_velocity(sim, range, [0.0; 3])
 }
 
 /// Resets the reported displacement of the nodes in `range` to zero without moving them:
 /// the current displacement is remembered in the `displacement_reset` field (declared by
 /// [`crate::Mechanics`]) and subtracted by [`crate::output::displacement`].
-pub fn reset_displacement<D: Dim, B: Backend>(
-    sim: &mut Simulation<D, B>,
+pub fn reset_displacement<D: Dim>(
+    sim: &mut Simulation<D>,
     range: &Range,
 ) -> Result<usize, MechError> {
     let nodes = sim.mesh().select_nodes(range)?;
@@ -67,8 +64,8 @@ pub fn reset_displacement<D: Dim, B: Backend>(
 
 /// Resets the stress and the constitutive history variables of the elements in `range`
 /// to zero (the current shape becomes stress-free).
-pub fn reset_element_state<D: Dim, B: Backend>(
-    sim: &mut Simulation<D, B>,
+pub fn reset_element_state<D: Dim>(
+    sim: &mut Simulation<D>,
     range: &Range,
 ) -> Result<usize, MechError> {
     let elems = sim.mesh().select_elements(range)?;

@@ -15,8 +15,8 @@
 
 use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
 use pcdc_compute::{
-    Backend, ComputeError, DofConstraint, FieldId, FieldSpec, FieldStore, Fingerprint,
-    ForceContext, InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext,
+    ComputeError, DofConstraint, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext,
+    InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
 
@@ -267,7 +267,7 @@ fn unit<D: Dim>(d: &[f64; 3]) -> [f64; 3] {
     out
 }
 
-impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
+impl<D: Dim> Physics<D> for Boundary {
     fn name(&self) -> &str {
         "mechanical boundary"
     }
@@ -350,7 +350,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
         Ok(())
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let d = D::D;
         let t = ctx.kin.time;
         for (it, r) in self.items.iter().zip(&self.resolved) {
@@ -613,7 +613,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
 mod tests {
     use super::*;
     use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl, Precision};
-    use pcdc_compute::{CpuBackend, Table};
+    use pcdc_compute::Table;
     use pcdc_mesh::builders;
 
     fn ramp() -> TimeValue {
@@ -648,7 +648,7 @@ mod tests {
 
     fn check_sources<D: Dim>(mesh: &Mesh<D>, boundary: Boundary) {
         for precision in [Precision::F64, Precision::F32] {
-            let physics: Vec<Box<dyn Physics<D, CpuBackend>>> = vec![Box::new(boundary.clone())];
+            let physics: Vec<Box<dyn Physics<D>>> = vec![Box::new(boundary.clone())];
             let sources = offline_kernel_sources(mesh, physics, precision).unwrap();
             let ours: Vec<&str> = sources
                 .iter()

@@ -34,13 +34,13 @@
 //! damping it is reduced to `(2/ω)(√(1+ξ²) − ξ)`.
 //!
 //! ```
-//! use pcdc_compute::{CpuBackend, Simulation};
+//! use pcdc_compute::{Backend, Simulation};
 //! use pcdc_mech::{Boundary, LinearElastic, Mechanics};
-//! use pcdc_mesh::{builders, Range};
+//! use pcdc_mesh::{Range, builders};
 //!
 //! let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.1).unwrap();
 //! let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
-//! let mut sim = Simulation::builder(mesh, CpuBackend::new(1).unwrap())
+//! let mut sim = Simulation::builder(mesh, Backend::cpu(1).unwrap())
 //!     .physics(Mechanics::new().material(Range::All, rock))
 //!     .physics(Boundary::new().fix(Range::group("bottom")))
 //!     .gravity([0.0, -9.81, 0.0])

@@ -12,8 +12,8 @@ use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase};
 use pcdc_compute::{
-    names, Backend, ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext,
-    InitContext, Kinematics, Location, Physics, StableStep,
+    names, ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
+    Kinematics, Location, Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
@@ -483,7 +483,7 @@ impl Mechanics {
     }
 }
 
-impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
+impl<D: Dim> Physics<D> for Mechanics {
     fn name(&self) -> &str {
         "mechanics"
     }
@@ -615,7 +615,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Mechanics {
         })
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let ids = self.ids();
         let (d, npe, nsym) = (D::D, D::NODES_PER_ELEM, D::NSYM);
         let nx = if d == 2 { 1 } else { 9 };
@@ -874,7 +874,7 @@ mod gpu_tests {
     use super::*;
     use crate::LinearElastic;
     use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
-    use pcdc_compute::{CpuBackend, Precision};
+    use pcdc_compute::Precision;
     use pcdc_mesh::builders;
 
     /// A model with two history variables and no WGSL body (CPU only).
@@ -919,10 +919,8 @@ mod gpu_tests {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
         let m3 = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
         for p in [Precision::F64, Precision::F32] {
-            let s2 =
-                offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(mech(1e9))], p).unwrap();
-            let s3 =
-                offline_kernel_sources::<_, CpuBackend>(&m3, vec![Box::new(mech(1e9))], p).unwrap();
+            let s2 = offline_kernel_sources::<_>(&m2, vec![Box::new(mech(1e9))], p).unwrap();
+            let s3 = offline_kernel_sources::<_>(&m3, vec![Box::new(mech(1e9))], p).unwrap();
             for (label, src) in s2.iter().chain(&s3) {
                 if let Err(e) = validate_wgsl(src) {
                     panic!("{label} ({}) does not validate:\n{e}", p.name());
@@ -939,8 +937,7 @@ mod gpu_tests {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
         let mech = Mechanics::new().material(Range::All, CpuOnly);
         let err =
-            offline_kernel_sources::<_, CpuBackend>(&m2, vec![Box::new(mech)], Precision::F64)
-                .unwrap_err();
+            offline_kernel_sources::<_>(&m2, vec![Box::new(mech)], Precision::F64).unwrap_err();
         let msg = err.to_string();
         assert!(msg.contains("cpu-only") && msg.contains("WGSL"), "{msg}");
     }

@@ -1,7 +1,7 @@
 //! Output helpers: global stress, principal stresses, displacement, and a VTU/PVD
 //! writer for mechanical fields that ParaView opens.
 
-use pcdc_compute::{names, Backend, Simulation};
+use pcdc_compute::{names, Simulation};
 use pcdc_mesh::vtu::{DataArray, PvdSeries};
 use pcdc_mesh::Dim;
 
@@ -12,7 +12,7 @@ use crate::MechError;
 /// Element Cauchy stress in the global frame (Pa, tension positive), stride NSYM
 /// (2D: xx, yy, xy; 3D: xx, yy, zz, xy, yz, xz): the co-rotated stress rotated by the
 /// element's current rotation, `R σ Rᵀ`.
-pub fn global_stress<D: Dim, B: Backend>(sim: &Simulation<D, B>) -> Result<Vec<f64>, MechError> {
+pub fn global_stress<D: Dim>(sim: &Simulation<D>) -> Result<Vec<f64>, MechError> {
     let s = sim.field(names::STRESS)?;
     let mesh = sim.mesh();
     let mut out = s.to_vec();
@@ -75,16 +75,16 @@ pub fn principal_stress<D: Dim>(global: &[f64]) -> Vec<f64> {
 }
 
 /// Node displacement since the last [`crate::reset_displacement`] (m), stride D.
-pub fn displacement<D: Dim, B: Backend>(sim: &Simulation<D, B>) -> Result<Vec<f64>, MechError> {
+pub fn displacement<D: Dim>(sim: &Simulation<D>) -> Result<Vec<f64>, MechError> {
     let off = sim.field(DISPLACEMENT_RESET)?;
     Ok(sim.state.u.iter().zip(off).map(|(u, o)| u - o).collect())
 }
 
 /// Writes one VTU step with displacement, velocity, global stress, principal stresses and
 /// strain, on the deformed configuration.
-pub fn write_step<D: Dim, B: Backend>(
+pub fn write_step<D: Dim>(
     series: &mut PvdSeries,
-    sim: &Simulation<D, B>,
+    sim: &Simulation<D>,
 ) -> Result<std::path::PathBuf, MechError> {
     let disp = displacement(sim)?;
     let stress = global_stress(sim)?;

@@ -1,7 +1,7 @@
 //! Elastic element mechanics: objectivity, patch tests, parameter checks, determinism,
 //! save/restore, watchdog and static solves against closed forms.
 
-use pcdc_compute::{ComputeError, CpuBackend, Simulation, StaticOptions, Table};
+use pcdc_compute::{Backend, ComputeError, Simulation, StaticOptions, Table};
 use pcdc_mech::{
     output, set_velocity, Boundary, Constraint, FaceStress, LinearElastic, MechError, Mechanics,
 };
@@ -14,8 +14,8 @@ fn rock() -> LinearElastic {
     LinearElastic::new(E, 0.25, 1000.0).unwrap()
 }
 
-fn cpu(t: usize) -> CpuBackend {
-    CpuBackend::new(t).unwrap()
+fn cpu(t: usize) -> Backend {
+    Backend::cpu(t).unwrap()
 }
 
 fn free_sim<D: Dim>(mesh: Mesh<D>) -> Simulation<D> {

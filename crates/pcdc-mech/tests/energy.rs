@@ -10,15 +10,15 @@
 
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{
-    Backend, ComputeError, CpuBackend, EnergyBalance, FieldStore, ForceContext, InitContext,
-    Physics, Precision, Simulation, SlotBlock,
+    Backend, ComputeError, EnergyBalance, FieldStore, ForceContext, InitContext, Physics,
+    Precision, Simulation, SlotBlock,
 };
 use pcdc_mech::{Boundary, FaceStress, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim, Dim2, Mesh, Range};
 
 /// A 0.4 × 0.1 m cantilever: left end held, a downward traction on the right end, the
 /// bottom-left corner region pulled at a prescribed speed, gravity, damping.
-fn cantilever<B: Backend>(backend: B, steps: u64) -> EnergyBalance {
+fn cantilever(backend: Backend, steps: u64) -> EnergyBalance {
     let mesh = builders::rectangle(0.0, 0.0, 0.4, 0.1, 0.02).unwrap();
     let rock = LinearElastic::new(1e9, 0.25, 2000.0)
         .unwrap()
@@ -51,7 +51,7 @@ fn cantilever<B: Backend>(backend: B, steps: u64) -> EnergyBalance {
 fn supports_do_no_work_and_an_elastic_body_dissipates_nothing() {
     let mesh = builders::rectangle(0.0, 0.0, 0.4, 0.1, 0.02).unwrap();
     let rock = LinearElastic::new(1e9, 0.25, 2000.0).unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(0).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(0).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(
             Boundary::new()
@@ -73,7 +73,7 @@ fn supports_do_no_work_and_an_elastic_body_dissipates_nothing() {
 
 #[test]
 fn the_balance_closes_on_a_loaded_damped_cantilever() {
-    let b = cantilever(CpuBackend::new(0).unwrap(), 3000);
+    let b = cantilever(Backend::cpu(0).unwrap(), 3000);
     let reference = (b.initial + b.external_work).max(b.total());
     println!("{b:#?}\nexcess {:e} of {:e}", b.excess(), reference);
     assert!(reference > 0.0);
@@ -97,7 +97,7 @@ struct AntiDamper {
     slots: Option<SlotBlock>,
 }
 
-impl<D: Dim> Physics<D, CpuBackend> for AntiDamper {
+impl<D: Dim> Physics<D> for AntiDamper {
     fn name(&self) -> &str {
         "anti-damper"
     }
@@ -106,10 +106,7 @@ impl<D: Dim> Physics<D, CpuBackend> for AntiDamper {
         self.slots = Some(ctx.register_slots(&nodes)?);
         Ok(())
     }
-    fn compute_forces(
-        &self,
-        ctx: &mut ForceContext<'_, D, CpuBackend>,
-    ) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         for (i, f) in ctx.slots.iter_mut().enumerate() {
             *f = self.c * ctx.kin.mass[i / D::D] * ctx.kin.v[i];
         }
@@ -125,7 +122,7 @@ impl<D: Dim> Physics<D, CpuBackend> for AntiDamper {
 fn the_watchdog_names_a_physics_that_injects_energy() {
     let mesh: Mesh<Dim2> = builders::rectangle(0.0, 0.0, 0.2, 0.1, 0.02).unwrap();
     let rock = LinearElastic::new(1e9, 0.25, 2000.0).unwrap();
-    let mut sim = Simulation::builder(mesh, CpuBackend::new(0).unwrap())
+    let mut sim = Simulation::builder(mesh, Backend::cpu(0).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(AntiDamper {
             c: 50.0,
@@ -165,7 +162,7 @@ fn a_tolerance_that_is_not_positive_is_an_error() {
     let mesh: Mesh<Dim2> = builders::rectangle(0.0, 0.0, 0.2, 0.1, 0.05).unwrap();
     let rock = LinearElastic::new(1e9, 0.25, 2000.0).unwrap();
     for tol in [0.0, -1.0, f64::NAN] {
-        let err = Simulation::builder(mesh.clone(), CpuBackend::new(0).unwrap())
+        let err = Simulation::builder(mesh.clone(), Backend::cpu(0).unwrap())
             .physics(Mechanics::new().material(Range::All, rock.clone()))
             .energy_watchdog(tol)
             .build()
@@ -181,7 +178,7 @@ fn gpu_f64_accumulates_the_cpu_balance() {
         return;
     };
     let steps = 1000;
-    let c = cantilever(CpuBackend::new(0).unwrap(), steps);
+    let c = cantilever(Backend::cpu(0).unwrap(), steps);
     let g = cantilever(gpu, steps);
     let scale = (c.initial + c.external_work).max(c.total());
     let close = |a: f64, b: f64, what: &str| {

@@ -1,4 +1,4 @@
-//! CPU–GPU parity of the mechanical boundary conditions: the same scene on `CpuBackend`
+//! CPU–GPU parity of the mechanical boundary conditions: the same scene on `Backend`
 //! and on the wgpu backend in f64 must give the same displacements to rounding
 //! (max |u_gpu − u_cpu| / max |u_cpu| ≤ 1e-12).
 //!
@@ -13,8 +13,8 @@
 
 use pcdc_compute::gpu::{gpu_test_backend, GpuSetup, Precision};
 use pcdc_compute::{
-    Backend, ComputeError, CpuBackend, FieldStore, ForceContext, InitContext, Physics, Simulation,
-    Table, TimeValue, WgpuBackend,
+    Backend, ComputeError, FieldStore, ForceContext, InitContext, Physics, Simulation, Table,
+    TimeValue,
 };
 use pcdc_mech::{Boundary, Constraint, FaceStress, LinearElastic, Mechanics, ACCEL_VELOCITY};
 use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh, Range};
@@ -27,7 +27,7 @@ struct PointMass {
     mass: f64,
 }
 
-impl<D: Dim, B: Backend> Physics<D, B> for PointMass {
+impl<D: Dim> Physics<D> for PointMass {
     fn name(&self) -> &str {
         "point masses"
     }
@@ -48,7 +48,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for PointMass {
         }
     }
 
-    fn compute_forces(&self, _ctx: &mut ForceContext<'_, D, B>) -> Result<(), ComputeError> {
+    fn compute_forces(&self, _ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         Ok(())
     }
 
@@ -57,12 +57,12 @@ impl<D: Dim, B: Backend> Physics<D, B> for PointMass {
     }
 }
 
-fn gpu() -> Option<WgpuBackend> {
+fn gpu() -> Option<Backend> {
     gpu_test_backend(Some(Precision::F64))
 }
 
-fn cpu() -> CpuBackend {
-    CpuBackend::new(1).unwrap()
+fn cpu() -> Backend {
+    Backend::cpu(1).unwrap()
 }
 
 fn table(points: &[(f64, f64)]) -> TimeValue {
@@ -86,13 +86,7 @@ fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
 
 /// Runs both simulations `steps` steps (the GPU one in a single `run`) and checks the
 /// displacement (and, with `all`, the velocity and the acceleration field) to `TOL`.
-fn compare<D: Dim>(
-    name: &str,
-    mut c: Simulation<D, CpuBackend>,
-    mut g: Simulation<D, WgpuBackend>,
-    steps: u64,
-    all: bool,
-) {
+fn compare<D: Dim>(name: &str, mut c: Simulation<D>, mut g: Simulation<D>, steps: u64, all: bool) {
     assert!(
         g.gpu_kernels().iter().any(|l| l.starts_with("boundary")),
         "{name}: no boundary kernel in {:?}",
@@ -135,7 +129,7 @@ fn compare<D: Dim>(
 /// Every item kind in 2D on free point masses: velocity table, acceleration table with
 /// line and plane constraints after it (same nodes, order matters), node force, face
 /// stresses following the moving faces, fixed nodes.
-fn alone_2d<B: Backend>(backend: B) -> Simulation<Dim2, B> {
+fn alone_2d(backend: Backend) -> Simulation<Dim2> {
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.125).unwrap();
     let boundary = Boundary::new()
         .velocity(
@@ -184,7 +178,7 @@ fn alone_2d<B: Backend>(backend: B) -> Simulation<Dim2, B> {
 }
 
 /// Every item kind in 3D on free point masses.
-fn alone_3d<B: Backend>(backend: B) -> Simulation<Dim3, B> {
+fn alone_3d(backend: Backend) -> Simulation<Dim3> {
     let mesh = builders::cuboid([0.0; 3], [1.0, 0.5, 0.5], 0.25).unwrap();
     let boundary = Boundary::new()
         .face_stress(
@@ -273,7 +267,7 @@ fn rock() -> LinearElastic {
 }
 
 /// Rectangle: velocity table on top, bottom fixed, a normal pressure on the right side.
-fn elastic_rect<B: Backend>(backend: B) -> Simulation<Dim2, B> {
+fn elastic_rect(backend: Backend) -> Simulation<Dim2> {
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.0625).unwrap();
     let boundary = Boundary::new()
         .velocity(
@@ -298,7 +292,7 @@ fn elastic_rect<B: Backend>(backend: B) -> Simulation<Dim2, B> {
 
 /// Rectangle: prescribed acceleration on the left side, oblique line constraint on the
 /// bottom, plane constraint on the right, node force on the top.
-fn elastic_accel<B: Backend>(backend: B) -> Simulation<Dim2, B> {
+fn elastic_accel(backend: Backend) -> Simulation<Dim2> {
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.0625).unwrap();
     let boundary = Boundary::new()
         .acceleration(
@@ -327,7 +321,7 @@ fn elastic_accel<B: Backend>(backend: B) -> Simulation<Dim2, B> {
 }
 
 /// Cuboid: bottom fixed, face stress (diagonal and normal) on a side, node force on top.
-fn elastic_cuboid<B: Backend>(backend: B) -> Simulation<Dim3, B> {
+fn elastic_cuboid(backend: Backend) -> Simulation<Dim3> {
     let mesh = builders::cuboid([0.0; 3], [1.0, 0.5, 0.5], 0.125).unwrap();
     let boundary = Boundary::new()
         .fix(Range::group("zmin"))

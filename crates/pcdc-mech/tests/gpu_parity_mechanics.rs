@@ -3,7 +3,7 @@
 //! and printed. Without a GPU adapter the tests skip (and fail with PCDC_REQUIRE_GPU=1).
 
 use pcdc_compute::gpu::gpu_test_backend;
-use pcdc_compute::{Backend, CpuBackend, Precision, Simulation};
+use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim, Mesh, Range};
 
@@ -16,7 +16,7 @@ fn noise(i: usize) -> f64 {
 
 /// A free-vibration and spin scene: random initial displacement and a rigid spin, two
 /// materials (one damped, with an initial stress), `steps` explicit steps.
-fn scene<D: Dim, B: Backend>(mesh: Mesh<D>, backend: B, steps: u64) -> (Vec<f64>, Vec<f64>) {
+fn scene<D: Dim>(mesh: Mesh<D>, backend: Backend, steps: u64) -> (Vec<f64>, Vec<f64>) {
     let soft = LinearElastic::new(10e9, 0.3, 2400.0).unwrap();
     let stiff = LinearElastic::new(40e9, 0.2, 2700.0)
         .unwrap()
@@ -76,12 +76,12 @@ fn parity<D: Dim>(mesh: Mesh<D>, precision: Precision, tol: f64) {
         return;
     };
     let steps = 300;
-    let (u_cpu, s_cpu) = scene(mesh.clone(), CpuBackend::new(1).unwrap(), steps);
-    let reads = gpu.readbacks();
+    let (u_cpu, s_cpu) = scene(mesh.clone(), Backend::cpu(1).unwrap(), steps);
+    let reads = gpu.as_gpu().expect("a GPU backend").readbacks();
     let (u_gpu, s_gpu) = scene(mesh, gpu.clone(), steps);
     // One read-back for the whole 300-step run (plus none while building).
     assert_eq!(
-        gpu.readbacks() - reads,
+        gpu.as_gpu().expect("a GPU backend").readbacks() - reads,
         1,
         "device reads inside the step loop"
     );
@@ -90,7 +90,7 @@ fn parity<D: Dim>(mesh: Mesh<D>, precision: Precision, tol: f64) {
         "{} {} on {}: max relative difference displacement {du:.3e}, stress {ds:.3e}",
         D::NAME,
         precision.name(),
-        gpu.adapter_name()
+        gpu.as_gpu().expect("a GPU backend").adapter_name()
     );
     assert!(du <= tol, "displacement differs by {du:e} (> {tol:e})");
     assert!(ds <= tol * 10.0, "stress differs by {ds:e}");
@@ -126,7 +126,7 @@ fn watchdog_names_the_same_step_and_node() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    fn diverge<B: Backend>(backend: B) -> (u64, String) {
+    fn diverge(backend: Backend) -> (u64, String) {
         let mesh = builders::rectangle(0.0, 0.0, 0.2, 0.1, 0.02).unwrap();
         let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
         let mut sim = Simulation::builder(mesh, backend)
@@ -141,7 +141,7 @@ fn watchdog_names_the_same_step_and_node() {
             other => panic!("expected divergence, got {other:?}"),
         }
     }
-    let cpu = diverge(CpuBackend::new(1).unwrap());
+    let cpu = diverge(Backend::cpu(1).unwrap());
     let gpu = diverge(gpu);
     println!("cpu stops at {cpu:?}, gpu at {gpu:?}");
     assert_eq!(cpu, gpu);
@@ -191,7 +191,7 @@ fn relaxation_matches_cpu() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    fn relax<B: Backend>(backend: B) -> (u64, Vec<f64>) {
+    fn relax(backend: Backend) -> (u64, Vec<f64>) {
         let mesh = builders::rectangle(0.0, 0.0, 0.2, 0.4, 0.02).unwrap();
         let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
         let mut sim = Simulation::builder(mesh, backend)
@@ -207,7 +207,7 @@ fn relaxation_matches_cpu() {
         let r = sim.relax(&StaticOptions::default()).unwrap();
         (r.steps, sim.state.u.clone())
     }
-    let (n_cpu, u_cpu) = relax(CpuBackend::new(1).unwrap());
+    let (n_cpu, u_cpu) = relax(Backend::cpu(1).unwrap());
     let (n_gpu, u_gpu) = relax(gpu);
     let d = rel_diff(&u_cpu, &u_gpu);
     println!("relaxation: cpu {n_cpu} steps, gpu {n_gpu} steps, rel. diff u {d:.3e}");

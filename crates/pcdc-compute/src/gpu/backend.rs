@@ -3,45 +3,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use serde::{Deserialize, Serialize};
-
-use crate::{Backend, BackendKind, ComputeError, CpuBackend};
-
-/// Floating-point precision of the GPU kernels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Precision {
-    /// 64-bit (needs the adapter feature `SHADER_F64`); matches the CPU to rounding.
-    F64,
-    /// 32-bit: runs everywhere and fast on consumer GPUs; its error is measured, not hidden.
-    F32,
-}
-
-impl Precision {
-    /// `f64` or `f32`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Precision::F64 => "f64",
-            Precision::F32 => "f32",
-        }
-    }
-
-    /// Bytes per real number on the device.
-    pub fn bytes(self) -> usize {
-        match self {
-            Precision::F64 => 8,
-            Precision::F32 => 4,
-        }
-    }
-
-    /// Parses `f64` or `f32`.
-    pub fn parse(s: &str) -> Result<Self, ComputeError> {
-        match s {
-            "f64" => Ok(Precision::F64),
-            "f32" => Ok(Precision::F32),
-            _ => Err(ComputeError::param("precision", s, "expected f64 or f32")),
-        }
-    }
-}
+use crate::{Backend, ComputeError, CpuBackend, Precision};
 
 struct Device {
     device: wgpu::Device,
@@ -194,6 +156,16 @@ impl WgpuBackend {
         self.inner.readbacks.fetch_add(1, Ordering::Relaxed);
     }
 
+    /// Precision of the kernels.
+    pub fn precision(&self) -> Precision {
+        self.inner.precision
+    }
+
+    /// The host-side CPU pool (assembly checks, output).
+    pub(crate) fn host(&self) -> &CpuBackend {
+        &self.inner.host
+    }
+
     /// The device limits in force (the adapter's own).
     pub fn limits(&self) -> &wgpu::Limits {
         &self.inner.limits
@@ -208,86 +180,11 @@ impl WgpuBackend {
     }
 }
 
-impl Backend for WgpuBackend {
-    fn kind(&self) -> BackendKind {
-        BackendKind::Gpu
-    }
-    fn threads(&self) -> usize {
-        1
-    }
-    fn precision_kind(&self) -> Precision {
-        self.inner.precision
-    }
-    fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
-        self.inner.host.install(f)
-    }
-    fn as_gpu(&self) -> Option<&WgpuBackend> {
-        Some(self)
-    }
-}
-
-/// The backend a program picks at run time: from `--backend cpu|gpu` and
-/// `--precision f64|f32` on the command line, else from `PCDC_BACKEND` and
-/// `PCDC_PRECISION`, else the CPU in f64.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BackendChoice {
-    /// CPU or GPU.
-    pub kind: BackendKind,
-    /// Requested precision (`None`: f64 where available).
-    pub precision: Option<Precision>,
-}
-
-impl BackendChoice {
-    /// Reads the choice from the process arguments and environment.
-    pub fn from_env_args() -> Result<Self, ComputeError> {
-        let args: Vec<String> = std::env::args().skip(1).collect();
-        Self::parse(&args)
-    }
-
-    /// Reads the choice from `args` (`--backend X`, `--backend=X`, `--precision Y`), falling
-    /// back to `PCDC_BACKEND` / `PCDC_PRECISION`. Unrelated arguments are ignored.
-    pub fn parse(args: &[String]) -> Result<Self, ComputeError> {
-        let find = |flag: &str| -> Option<String> {
-            let eq = format!("{flag}=");
-            let mut it = args.iter();
-            while let Some(a) = it.next() {
-                if a == flag {
-                    return it.next().cloned();
-                }
-                if let Some(v) = a.strip_prefix(&eq) {
-                    return Some(v.to_string());
-                }
-            }
-            None
-        };
-        let backend = find("--backend")
-            .or_else(|| std::env::var("PCDC_BACKEND").ok())
-            .unwrap_or_else(|| "cpu".into());
-        let kind = match backend.as_str() {
-            "cpu" => BackendKind::Cpu,
-            "gpu" => BackendKind::Gpu,
-            other => return Err(ComputeError::param("backend", other, "expected cpu or gpu")),
-        };
-        let precision = find("--precision")
-            .or_else(|| std::env::var("PCDC_PRECISION").ok())
-            .map(|p| Precision::parse(&p))
-            .transpose()?;
-        if kind == BackendKind::Cpu && precision == Some(Precision::F32) {
-            return Err(ComputeError::param(
-                "precision",
-                "f32",
-                "the CPU backend runs in f64 only; f32 is a GPU option",
-            ));
-        }
-        Ok(BackendChoice { kind, precision })
-    }
-}
-
 /// For GPU tests: the backend, or `None` after printing why the test is skipped. With
 /// `PCDC_REQUIRE_GPU=1` a missing adapter panics instead (CI installs lavapipe).
-pub fn gpu_test_backend(precision: Option<Precision>) -> Option<WgpuBackend> {
+pub fn gpu_test_backend(precision: Option<Precision>) -> Option<Backend> {
     match WgpuBackend::new(precision) {
-        Ok(b) => Some(b),
+        Ok(b) => Some(Backend::Gpu(b)),
         Err(e) => {
             if std::env::var("PCDC_REQUIRE_GPU").is_ok_and(|v| v == "1") {
                 panic!("PCDC_REQUIRE_GPU=1 but no usable GPU adapter: {e}");

@@ -19,16 +19,34 @@
 //! its slots in a fixed order, exactly as on the CPU; the only atomics are the integer
 //! `atomicMin`s of the divergence watchdog.
 
+//!
+//! The declarations ([`GpuSetup`], [`Kernel`], WGSL assembly) are always compiled, so a
+//! physics crate declares its kernels without any cfg; the device, the runs and naga's
+//! validation come with the cargo feature `gpu` (on by default).
+
+#[cfg(feature = "gpu")]
 mod backend;
+#[cfg(feature = "gpu")]
 mod energy;
+#[cfg_attr(not(feature = "gpu"), allow(dead_code))]
 mod program;
+#[cfg(feature = "gpu")]
 mod run;
 
-pub use backend::{gpu_test_backend, BackendChoice, Precision, WgpuBackend};
+#[cfg(feature = "gpu")]
+pub use backend::{gpu_test_backend, WgpuBackend};
 pub use program::{
-    assemble_source, offline_kernel_sources, splice_models, validate_wgsl, Access, ConstValue,
-    GpuBuffer, GpuData, GpuSetup, Kernel, ModelSplice, Phase, PRELUDE,
+    assemble_source, splice_models, Access, ConstValue, GpuBuffer, GpuData, GpuSetup, Kernel,
+    ModelSplice, Phase, PRELUDE,
 };
+#[cfg(feature = "gpu")]
+pub use program::{offline_kernel_sources, validate_wgsl};
+#[cfg(not(feature = "gpu"))]
+mod disabled;
+pub use crate::Precision;
+#[cfg(not(feature = "gpu"))]
+pub(crate) use disabled::GpuRun;
+#[cfg(feature = "gpu")]
 pub(crate) use run::GpuRun;
 
 /// WGSL library of shared geometry for physics kernels (prepend it to a kernel's source):

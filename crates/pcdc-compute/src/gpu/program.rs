@@ -456,6 +456,7 @@ pub fn splice_models<'a>(
 
 /// Parses and validates a WGSL module with naga (with f64 support), as wgpu would;
 /// returns the diagnostic with source context on failure.
+#[cfg(feature = "gpu")]
 pub fn validate_wgsl(source: &str) -> Result<(), String> {
     let module = naga::front::wgsl::parse_str(source).map_err(|e| e.emit_to_string(source))?;
     let mut v = naga::valid::Validator::new(
@@ -476,9 +477,10 @@ impl Program {
 /// Builds the GPU program of `physics` on `mesh` without a device and returns every
 /// assembled kernel as `(label, WGSL)`, built-in kernels included: what a unit test
 /// feeds to [`validate_wgsl`]. Errors are those the simulation build would report.
-pub fn offline_kernel_sources<D: Dim, B: crate::Backend>(
+#[cfg(feature = "gpu")]
+pub fn offline_kernel_sources<D: Dim>(
     mesh: &Mesh<D>,
-    physics: Vec<Box<dyn crate::Physics<D, B>>>,
+    physics: Vec<Box<dyn crate::Physics<D>>>,
     precision: Precision,
 ) -> Result<Vec<(String, String)>, ComputeError> {
     let mut physics = physics;
@@ -502,10 +504,9 @@ pub fn offline_kernel_sources<D: Dim, B: crate::Backend>(
     Ok(out)
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "gpu"))]
 mod tests {
     use super::*;
-    use crate::CpuBackend;
     use pcdc_mesh::builders;
 
     #[test]
@@ -513,8 +514,8 @@ mod tests {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
         let m3 = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
         for p in [Precision::F64, Precision::F32] {
-            let s2 = offline_kernel_sources::<_, CpuBackend>(&m2, Vec::new(), p).unwrap();
-            let s3 = offline_kernel_sources::<_, CpuBackend>(&m3, Vec::new(), p).unwrap();
+            let s2 = offline_kernel_sources(&m2, Vec::new(), p).unwrap();
+            let s3 = offline_kernel_sources(&m3, Vec::new(), p).unwrap();
             assert_eq!(s2.len(), 3);
             for (label, src) in s2.iter().chain(&s3) {
                 assert!(src.starts_with(&format!("alias Real = {};", p.name())));

@@ -4,7 +4,7 @@ use pcdc_mesh::{Dim, Mesh};
 
 use super::program::{assemble, builtin, validate_wgsl, BufferDecl, Elem, Program, PARAM_HEADER};
 use super::{Access, GpuBuffer, GpuData, GpuSetup, Kernel, Phase, Precision, WgpuBackend};
-use crate::{Backend, ComputeError, FieldStore, Physics, Simulation};
+use crate::{ComputeError, FieldStore, Physics, Simulation};
 
 /// Steps recorded per submission (one parameter record each).
 const BATCH: usize = 128;
@@ -53,9 +53,9 @@ fn decl(label: &str, elem: Elem, len: usize, data: Option<GpuData>) -> BufferDec
 }
 
 /// Declares the built-in and field buffers and lets every physics add its kernels.
-pub(crate) fn build_program<D: Dim, B: Backend>(
+pub(crate) fn build_program<D: Dim>(
     mesh: &Mesh<D>,
-    physics: &mut [Box<dyn Physics<D, B>>],
+    physics: &mut [Box<dyn Physics<D>>],
     fields: &FieldStore,
     layout: &crate::simulation::Layout,
     precision: Precision,
@@ -192,12 +192,12 @@ fn reals_from(bytes: &[u8], p: Precision, out: &mut [f64]) {
 
 impl GpuRun {
     /// Creates buffers and pipelines for a freshly built simulation.
-    pub(crate) fn new<D: Dim, B: Backend>(
+    pub(crate) fn new<D: Dim>(
         backend: &WgpuBackend,
-        sim: &mut Simulation<D, B>,
+        sim: &mut Simulation<D>,
         layout: &crate::simulation::Layout,
     ) -> Result<Self, ComputeError> {
-        let precision = backend.precision_kind();
+        let precision = backend.precision();
         let program = build_program(
             &sim.mesh,
             &mut sim.physics,
@@ -485,7 +485,7 @@ impl GpuRun {
     }
 
     /// Host state → device (the host state is the truth between runs).
-    fn upload<D: Dim, B: Backend>(&self, sim: &Simulation<D, B>) {
+    fn upload<D: Dim>(&self, sim: &Simulation<D>) {
         self.write_reals(builtin::DISPLACEMENT, &sim.state.u);
         self.write_reals(builtin::VELOCITY, &sim.state.v);
         self.write_reals(builtin::MASS, &sim.mass);
@@ -506,19 +506,13 @@ impl GpuRun {
 
     /// Uploads the host state unless the simulation knows the device already holds it
     /// (`device_fresh`, set only by internal loops right after a read-back).
-    fn sync_to_device<D: Dim, B: Backend>(&self, sim: &mut Simulation<D, B>) {
+    fn sync_to_device<D: Dim>(&self, sim: &mut Simulation<D>) {
         if !std::mem::take(&mut sim.device_fresh) {
             self.upload(sim);
         }
     }
 
-    fn record<D: Dim, B: Backend>(
-        &self,
-        sim: &Simulation<D, B>,
-        t: f64,
-        step: u64,
-        out: &mut Vec<f64>,
-    ) {
+    fn record<D: Dim>(&self, sim: &Simulation<D>, t: f64, step: u64, out: &mut Vec<f64>) {
         let start = out.len();
         out.resize(start + self.record_reals, 0.0);
         let r = &mut out[start..];
@@ -553,9 +547,9 @@ impl GpuRun {
     }
 
     /// Runs `n` explicit steps on the device, then reads the state back once.
-    pub(crate) fn run<D: Dim, B: Backend>(
+    pub(crate) fn run<D: Dim>(
         &mut self,
-        sim: &mut Simulation<D, B>,
+        sim: &mut Simulation<D>,
         n: u64,
     ) -> Result<(), ComputeError> {
         if n == 0 {
@@ -693,9 +687,9 @@ impl GpuRun {
 
     /// Evaluates the forces at the current state (no step), reads back state, node force
     /// and, with `gross`, the sum of absolute slot contributions per dof.
-    pub(crate) fn evaluate<D: Dim, B: Backend>(
+    pub(crate) fn evaluate<D: Dim>(
         &mut self,
-        sim: &mut Simulation<D, B>,
+        sim: &mut Simulation<D>,
         gross: bool,
     ) -> Result<Option<Vec<f64>>, ComputeError> {
         self.sync_to_device(sim);
@@ -740,9 +734,9 @@ impl GpuRun {
 
     /// Copies u, v, force, status (and gross) and the fields into the staging buffer and
     /// reads them into the host state: one device-to-host read.
-    fn read_back<D: Dim, B: Backend>(
+    fn read_back<D: Dim>(
         &mut self,
-        sim: &mut Simulation<D, B>,
+        sim: &mut Simulation<D>,
         gross: bool,
     ) -> Result<([u32; 4], Option<Vec<f64>>), ComputeError> {
         let device = self.backend.device();

@@ -6,7 +6,7 @@ use pcdc_mesh::{builders, Dim2, Mesh};
 
 use super::*;
 use crate::{
-    CpuBackend, FieldSpec, ForceContext, InitContext, Kinematics, Location, Physics, StableStep,
+    Backend, FieldSpec, ForceContext, InitContext, Kinematics, Location, Physics, StableStep,
 };
 
 /// Every node is tied to its rest position by a spring `k` and carries a mass `rho`;
@@ -62,10 +62,7 @@ impl Physics<Dim2> for Springs {
             physics: "springs".into(),
         })
     }
-    fn compute_forces(
-        &self,
-        ctx: &mut ForceContext<'_, Dim2, CpuBackend>,
-    ) -> Result<(), ComputeError> {
+    fn compute_forces(&self, ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
         for (s, u) in ctx.slots.iter_mut().zip(ctx.kin.u) {
             *s = -self.k * u;
         }
@@ -90,8 +87,8 @@ impl Physics<Dim2> for Springs {
     }
 }
 
-fn cpu() -> CpuBackend {
-    CpuBackend::new(1).unwrap()
+fn cpu() -> Backend {
+    Backend::cpu(1).unwrap()
 }
 
 fn scene_with(mesh: Mesh<Dim2>, springs: Springs) -> Simulation<Dim2> {
@@ -342,10 +339,7 @@ impl Physics<Dim2> for Quiet {
     fn init(&mut self, _ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
         Ok(())
     }
-    fn compute_forces(
-        &self,
-        _ctx: &mut ForceContext<'_, Dim2, CpuBackend>,
-    ) -> Result<(), ComputeError> {
+    fn compute_forces(&self, _ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
         Ok(())
     }
 }

@@ -556,8 +556,8 @@ pub(crate) struct Setup<'a> {
 /// Runs the platen test: builds specimen + platens, splits the specimen into FDEM
 /// elements with joints, loads by platen velocity until the load has dropped to
 /// `stop_fraction` of its peak (or the closure limit) and reports the history.
-pub(crate) fn run<B: Backend>(
-    backend: &B,
+pub(crate) fn run(
+    backend: &Backend,
     s: &Setup<'_>,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<Raw, SceneError> {
@@ -674,7 +674,7 @@ pub(crate) fn run<B: Backend>(
     let frame_every = (max_steps / u64::from(s.output.frames.max(1))).max(every);
     let mut next_frame = frame_every;
     let chunk = reaction_chunk(backend.kind(), every);
-    let mean_y = |sim: &Simulation<Dim2, B>, list: &[u32]| {
+    let mean_y = |sim: &Simulation<Dim2>, list: &[u32]| {
         list.iter()
             .map(|&n| sim.state.u[2 * n as usize + 1])
             .sum::<f64>()
@@ -797,8 +797,8 @@ fn reaction_chunk(kind: BackendKind, every: u64) -> u64 {
 
 /// Broken joints (D = 1) by failure mode and where they are. A joint's mode is that of
 /// the first of its Gauss points that broke with a recorded mode.
-fn broken_joints<B: Backend>(
-    sim: &Simulation<Dim2, B>,
+fn broken_joints(
+    sim: &Simulation<Dim2>,
     joints: &pcdc_cohesive::Joints,
 ) -> Result<(BrokenCount, Vec<Crack>), SceneError> {
     let damage = sim.field(JOINT_DAMAGE)?;
@@ -837,9 +837,9 @@ fn broken_joints<B: Backend>(
 
 /// One VTU frame: displacement, velocity (points); stress, σ1, largest joint damage and
 /// number of broken joints per element (cells).
-fn write_frame<B: Backend>(
+fn write_frame(
     series: &mut PvdSeries,
-    sim: &Simulation<Dim2, B>,
+    sim: &Simulation<Dim2>,
     joints: &pcdc_cohesive::Joints,
 ) -> Result<(), SceneError> {
     let damage = sim.field(JOINT_DAMAGE)?;

@@ -98,7 +98,7 @@ impl Outcome {
 }
 
 /// Runs the scene on `backend` (cloned into the simulation).
-pub fn run<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
+pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let mesh = builders::dog_bone(0.05, 0.15, 0.15, NECK, p.size)?;
     let split = split_nodes(&mesh, &Range::All)?;
@@ -183,9 +183,9 @@ pub fn run<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
 
 /// One VTU frame: displacement, global stress and, per element, the largest damage of
 /// its joints.
-fn write_frame<B: Backend>(
+fn write_frame(
     series: &mut PvdSeries,
-    sim: &Simulation<pcdc_mesh::Dim2, B>,
+    sim: &Simulation<pcdc_mesh::Dim2>,
     joints: &pcdc_cohesive::Joints,
 ) -> Result<(), SceneError> {
     let damage = sim.field(JOINT_DAMAGE)?;

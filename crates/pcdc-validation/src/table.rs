@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-use pcdc_compute::{Backend, CpuBackend, Precision, WgpuBackend};
+use pcdc_compute::{Backend, BackendKind, Precision};
 
 use crate::plot::Plot;
 use crate::report::SceneError;
@@ -205,7 +205,7 @@ fn pct(x: f64) -> String {
 }
 
 /// Runs one job on `backend`.
-pub fn run_job<B: Backend>(backend: &B, job: &Job) -> Result<Row, SceneError> {
+pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
     let start = Instant::now();
     let row = |elements, error: f64, tol: String, pass, steps| Row {
         case: job.case.into(),
@@ -322,48 +322,25 @@ pub fn run_job<B: Backend>(backend: &B, job: &Job) -> Result<Row, SceneError> {
     })
 }
 
-/// A backend the report runs on.
-pub enum AnyBackend {
-    /// The CPU (all threads).
-    Cpu(CpuBackend),
-    /// The GPU at one precision.
-    Gpu(WgpuBackend),
-}
-
-impl AnyBackend {
-    /// `cpu`, `gpu-f64` or `gpu-f32`.
-    pub fn label(&self) -> String {
-        match self {
-            AnyBackend::Cpu(_) => "cpu".into(),
-            AnyBackend::Gpu(b) => format!("gpu-{}", b.precision()),
-        }
-    }
-
-    /// Runs `job` on this backend.
-    pub fn run(&self, job: &Job) -> Result<Row, SceneError> {
-        match self {
-            AnyBackend::Cpu(b) => run_job(b, job),
-            AnyBackend::Gpu(b) => run_job(b, job),
-        }
-    }
-
-    /// Whether this is a GPU backend.
-    pub fn is_gpu(&self) -> bool {
-        matches!(self, AnyBackend::Gpu(_))
+/// `cpu`, `gpu-f64` or `gpu-f32`: how the report names a backend.
+pub fn backend_label(backend: &Backend) -> String {
+    match backend.kind() {
+        BackendKind::Cpu => "cpu".into(),
+        BackendKind::Gpu => format!("gpu-{}", backend.precision()),
     }
 }
 
 /// Every backend available here: the CPU, and the GPU in f64 (where the adapter has it)
 /// and f32. Says on stderr why a GPU backend is missing.
-pub fn available_backends() -> Vec<AnyBackend> {
+pub fn available_backends() -> Vec<Backend> {
     let mut out = Vec::new();
-    match CpuBackend::new(0) {
-        Ok(b) => out.push(AnyBackend::Cpu(b)),
+    match Backend::cpu(0) {
+        Ok(b) => out.push(b),
         Err(e) => eprintln!("no CPU backend: {e}"),
     }
     for p in [Precision::F64, Precision::F32] {
-        match WgpuBackend::new(Some(p)) {
-            Ok(b) => out.push(AnyBackend::Gpu(b)),
+        match Backend::gpu(Some(p)) {
+            Ok(b) => out.push(b),
             Err(e) => eprintln!("no GPU backend in {}: {e}", p.name()),
         }
     }

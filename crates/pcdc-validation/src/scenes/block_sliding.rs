@@ -71,12 +71,12 @@ pub const SIZES: [f64; 3] = [0.05, 0.025, 0.0125];
 
 /// Runs one initial speed `v0` (m/s) on `backend` (cloned into the simulation), with
 /// 2.5 cm triangles.
-pub fn run<B: Backend>(backend: &B, v0: f64) -> Result<Outcome, SceneError> {
+pub fn run(backend: &Backend, v0: f64) -> Result<Outcome, SceneError> {
     run_sized(backend, v0, 0.025)
 }
 
 /// Runs one initial speed `v0` (m/s) with triangles of size `size` (m).
-pub fn run_sized<B: Backend>(backend: &B, v0: f64, size: f64) -> Result<Outcome, SceneError> {
+pub fn run_sized(backend: &Backend, v0: f64, size: f64) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let d_exact = expected(v0);
     let mesh = block_on_base(size, 0.3 + 1.2 * d_exact)?;
@@ -99,14 +99,14 @@ pub fn run_sized<B: Backend>(backend: &B, v0: f64, size: f64) -> Result<Outcome,
     for &n in &nodes {
         sim.state.v[2 * n as usize] = v0;
     }
-    let mean_x = |s: &Simulation<Dim2, B>| {
+    let mean_x = |s: &Simulation<Dim2>| {
         nodes
             .iter()
             .map(|&n| s.mesh().node(n as usize)[0] + s.state.u[2 * n as usize])
             .sum::<f64>()
             / nodes.len() as f64
     };
-    let mean_vx = |s: &Simulation<Dim2, B>| {
+    let mean_vx = |s: &Simulation<Dim2>| {
         nodes
             .iter()
             .map(|&n| s.state.v[2 * n as usize])

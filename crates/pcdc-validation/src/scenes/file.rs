@@ -8,7 +8,7 @@
 //! would need against the [memory limit](pcdc_mesh::memory).
 //!
 //! ```
-//! use pcdc::scenes::file::SceneFile;
+//! use pcdc_validation::scenes::file::SceneFile;
 //! let scene = SceneFile::from_toml("scene = \"ucs\"\n[sample]\nmesh_size = 0.004\n").unwrap();
 //! match scene {
 //!     SceneFile::Ucs(p) => assert_eq!(p.sample.mesh_size, 0.004),

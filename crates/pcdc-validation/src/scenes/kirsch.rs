@@ -144,7 +144,7 @@ pub fn mesh(p: &Params) -> Result<Mesh<Dim2>, SceneError> {
 /// Runs the scene with one solver on `backend` (cloned into the simulation). The direct
 /// solve factorises on the host (faer) on every backend; dynamic relaxation steps on the
 /// backend.
-pub fn run<B: Backend>(backend: &B, p: &Params, solver: Solver) -> Result<Outcome, SceneError> {
+pub fn run(backend: &Backend, p: &Params, solver: Solver) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let mesh = mesh(p)?;
     let a = p.radius;

@@ -70,8 +70,8 @@ pub fn c_exact() -> f64 {
     (E * (1.0 - NU) / (RHO * (1.0 + NU) * (1.0 - 2.0 * NU))).sqrt()
 }
 
-fn run_on<D: Dim, B: Backend>(
-    backend: &B,
+fn run_on<D: Dim>(
+    backend: &Backend,
     mesh: pcdc_mesh::Mesh<D>,
     side_groups: &[&str],
 ) -> Result<Outcome, SceneError> {
@@ -93,7 +93,7 @@ fn run_on<D: Dim, B: Backend>(
         .physics(bc)
         .build()?;
     let d = D::D;
-    let section = |sim: &Simulation<D, B>, x: f64| -> Result<Vec<u32>, SceneError> {
+    let section = |sim: &Simulation<D>, x: f64| -> Result<Vec<u32>, SceneError> {
         let (lo, hi) = sim.mesh().edge_length_range();
         let tol = lo.min(hi);
         let nodes = sim
@@ -115,7 +115,7 @@ fn run_on<D: Dim, B: Backend>(
     let (s1, s2) = (section(&sim, 0.25 * LENGTH)?, section(&sim, 0.75 * LENGTH)?);
     let x1 = sim.mesh().node(s1[0] as usize)[0];
     let x2 = sim.mesh().node(s2[0] as usize)[0];
-    let mean_v = |sim: &Simulation<D, B>, s: &[u32]| {
+    let mean_v = |sim: &Simulation<D>, s: &[u32]| {
         s.iter().map(|&n| sim.state.v[n as usize * d]).sum::<f64>() / s.len() as f64
     };
     let c = c_exact();
@@ -163,14 +163,14 @@ fn run_on<D: Dim, B: Backend>(
 }
 
 /// The 2D bar (height 0.1 m), rollers on top and bottom, on `backend`.
-pub fn run_2d<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
+pub fn run_2d(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     let mesh = builders::rectangle(0.0, 0.0, LENGTH, 0.1, p.size)?;
     run_on(backend, mesh, &["bottom", "top"])
 }
 
 /// The 3D bar (section 0.05 × 0.05 m, coarser: 2× the 2D size), rollers on the four
 /// sides, on `backend`.
-pub fn run_3d<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
+pub fn run_3d(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     let mesh = builders::cuboid([0.0; 3], [LENGTH, 0.05, 0.05], 2.0 * p.size)?;
     run_on(backend, mesh, &["ymin", "ymax", "zmin", "zmax"])
 }

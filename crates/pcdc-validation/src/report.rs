@@ -4,7 +4,7 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use pcdc_compute::{Backend, BackendChoice, BackendKind};
+use pcdc_compute::Backend;
 
 /// One machine-readable result line:
 /// `RESULT case=<name> metric=<name> value=<number> tol=<number> pass=<bool> elements=<n>
@@ -35,8 +35,8 @@ impl ResultLine {
     /// A result measured on `backend`: `backend=` and `precision=` are the backend's own
     /// ([`Backend::kind`], [`Backend::precision`]).
     #[allow(clippy::too_many_arguments)] // the fields of the line, in its order
-    pub fn new<B: Backend>(
-        backend: &B,
+    pub fn new(
+        backend: &Backend,
         case: &str,
         metric: &str,
         value: f64,
@@ -107,61 +107,6 @@ pub fn finish(result: Result<Vec<ResultLine>, Box<dyn std::error::Error>>) -> ! 
             eprintln!("error: {e}");
             std::process::exit(1)
         }
-    }
-}
-
-/// The backend a validation example runs on: `--backend cpu|gpu` and
-/// `--precision f64|f32` on its command line (also as `--backend=gpu`), else the
-/// `PCDC_BACKEND` and `PCDC_PRECISION` environment variables, else the CPU in f64 (see
-/// [`BackendChoice::from_env_args`]). Any other argument, a flag without its value and
-/// an unknown value are errors that name what is accepted.
-pub fn backend_choice() -> Result<BackendChoice, Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    check_backend_args(&args)?;
-    Ok(BackendChoice::parse(&args)?)
-}
-
-/// Usage of the backend flags, as printed in argument errors.
-pub const BACKEND_USAGE: &str = "--backend cpu|gpu, --precision f64|f32 (f32: GPU only)";
-
-/// Checks that `args` hold only the backend flags, each with a value (the values
-/// themselves are checked by [`BackendChoice::parse`]).
-pub fn check_backend_args(args: &[String]) -> Result<(), String> {
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--backend" | "--precision" => match it.next() {
-                Some(v) if !v.starts_with('-') => {}
-                _ => return Err(format!("{a} needs a value; accepted: {BACKEND_USAGE}")),
-            },
-            _ if a.starts_with("--backend=") || a.starts_with("--precision=") => {}
-            _ => return Err(format!("unknown argument '{a}'; accepted: {BACKEND_USAGE}")),
-        }
-    }
-    Ok(())
-}
-
-/// One line naming the backend in use, e.g. `cpu (2 threads), f64` or
-/// `gpu: llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, software adapter: correct, not fast), f32`.
-pub fn describe_backend<B: Backend>(backend: &B) -> String {
-    match (backend.kind(), backend.as_gpu()) {
-        (BackendKind::Gpu, Some(g)) => format!(
-            "gpu: {} ({}{}), {}",
-            g.adapter_name(),
-            g.api(),
-            if g.is_software() {
-                ", software adapter: correct, not fast"
-            } else {
-                ""
-            },
-            backend.precision()
-        ),
-        (kind, _) => format!(
-            "{} ({} threads), {}",
-            kind.name(),
-            backend.threads(),
-            backend.precision()
-        ),
     }
 }
 

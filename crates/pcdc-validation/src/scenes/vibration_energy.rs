@@ -69,11 +69,7 @@ pub struct Outcome {
     pub strain_energy: Vec<f64>,
 }
 
-fn run_on<D: Dim, B: Backend>(
-    backend: &B,
-    mesh: Mesh<D>,
-    p: &Params,
-) -> Result<Outcome, SceneError> {
+fn run_on<D: Dim>(backend: &Backend, mesh: Mesh<D>, p: &Params) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let (lo, hi) = mesh.bounding_box();
     let length = hi[0] - lo[0];
@@ -131,7 +127,7 @@ fn rock_modulus() -> f64 {
 }
 
 /// The 2D block 1 m × 0.25 m, on `backend`.
-pub fn run_2d<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
+pub fn run_2d(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     run_on(
         backend,
         builders::rectangle(0.0, 0.0, 1.0, 0.25, p.size)?,
@@ -140,7 +136,7 @@ pub fn run_2d<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError
 }
 
 /// The 3D block 1 m × 0.25 m × 0.25 m (element size 2.5× the 2D one), on `backend`.
-pub fn run_3d<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
+pub fn run_3d(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     run_on(
         backend,
         builders::cuboid([0.0; 3], [1.0, 0.25, 0.25], 2.5 * p.size)?,

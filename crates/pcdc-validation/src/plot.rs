@@ -6,14 +6,14 @@
 //! system fonts or font libraries are needed at build or run time.
 //!
 //! ```no_run
-//! use pcdc::plot::Plot;
+//! use pcdc_validation::plot::Plot;
 //! let x: Vec<f64> = (0..=50).map(|i| i as f64 * 0.1).collect();
 //! let y: Vec<f64> = x.iter().map(|t| t.sin()).collect();
 //! Plot::new("Sine", "t [s]", "u [m]")
 //!     .line("analytic", x.clone(), y.clone())
 //!     .points("numerical", x, y)
 //!     .save_png("target/figures/sine.png")?;
-//! # Ok::<(), pcdc::plot::PlotError>(())
+//! # Ok::<(), pcdc_validation::plot::PlotError>(())
 //! ```
 
 use std::path::Path;

@@ -113,7 +113,7 @@ fn geometry(size: f64) -> Result<(Mesh<Dim2>, usize), SceneError> {
 }
 
 /// Runs the scene on `backend`.
-pub fn run<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
+pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let (mesh, n_walls) = geometry(p.size)?;
     // FDEM region: the block (inside the box); the walls keep shared nodes.

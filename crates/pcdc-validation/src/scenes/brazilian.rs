@@ -204,8 +204,8 @@ impl Outcome {
 
 /// Runs the Brazilian test on `backend` (cloned into the simulation); `progress` is
 /// called at every recorded sample.
-pub fn run<B: Backend>(
-    backend: &B,
+pub fn run(
+    backend: &Backend,
     p: &Params,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<Outcome, SceneError> {
@@ -268,8 +268,8 @@ pub fn write_csv(out: &Outcome, path: &std::path::Path) -> std::io::Result<()> {
 /// CSV `brazilian_load.csv`, the PNG `brazilian_load.png` of load against platen
 /// closure, the crack map `brazilian_cracks.png` when joints broke), prints the summary
 /// and returns the RESULT line (metric [`Outcome::band_metric`], tol 1).
-pub fn report<B: Backend>(
-    backend: &B,
+pub fn report(
+    backend: &Backend,
     p: &Params,
     out: &Outcome,
 ) -> Result<crate::report::ResultLine, SceneError> {

@@ -536,8 +536,8 @@ pub fn fit_slope(x: &[f64], y: &[f64], peak: usize, lo: f64, hi: f64) -> Option<
 
 /// Runs the UCS test on `backend` (cloned into the simulation); `progress` is called at
 /// every recorded sample.
-pub fn run<B: Backend>(
-    backend: &B,
+pub fn run(
+    backend: &Backend,
     p: &Params,
     progress: &mut dyn FnMut(&Progress),
 ) -> Result<Outcome, SceneError> {
@@ -637,8 +637,8 @@ pub fn write_csv(out: &Outcome, path: &std::path::Path) -> std::io::Result<()> {
 /// `ucs_stress_strain.csv` and PNG `ucs_stress_strain.png`, and the crack map
 /// `ucs_cracks.png` when joints broke), prints the summary table and the quasi-static
 /// check, and returns the RESULT line (metric [`Outcome::acceptance`], tol 1).
-pub fn report<B: Backend>(
-    backend: &B,
+pub fn report(
+    backend: &Backend,
     p: &Params,
     out: &Outcome,
 ) -> Result<crate::report::ResultLine, SceneError> {
