@@ -1,8 +1,9 @@
 //! Elastic step throughput (element-steps per second) on the CPU backend, 1 thread and
-//! all threads, for about 200k triangles (the standard benchmark block of DESIGN.md,
-//! 0.05 x 0.10 m of right triangles, E = 30 GPa, nu = 0.25, rho = 2600, bottom fixed
-//! in y, top pushed at 0.05 m/s; nodes are shared here because the per-triangle nodes
-//! and joints of the full scene arrive with pcdc-cohesive) and about 200k tetrahedra.
+//! all threads, for about 200k triangles (the standard benchmark block of
+//! docs/design-targets.md, 0.05 x 0.10 m of right triangles, E = 30 GPa, nu = 0.25,
+//! rho = 2600, bottom fixed in y, top pushed at 0.05 m/s; nodes are shared here because
+//! the per-triangle nodes and joints of the full scene arrive with pcdc-cohesive) and
+//! about 200k tetrahedra.
 //!
 //! GPU rows (when an adapter exists, f64 and f32): one iteration is `run(GPU_STEPS)`,
 //! which includes one upload and one read-back of the state, so the rate is per

@@ -1,8 +1,9 @@
-//! The standard FDEM benchmark scene of DESIGN.md: a 0.05 x 0.10 m block of right triangles, every triangle with its own
-//! nodes, an intrinsic cohesive joint on every interior edge (penalties 10 E, overlap
-//! 100 E, Ts = 2 MPa, c = 10 MPa), E = 30 GPa, nu = 0.25, rho = 2600, bottom fixed in y,
-//! top pushed at 0.05 m/s, dt = 0.05 h / c_p; 10k, 50k and 200k triangles, 1 thread and
-//! all threads. Rows `..._joints_...` leave contact out; rows `..._contact_...` are the
+//! The standard FDEM benchmark scene (docs/design-targets.md, with its speed targets): a
+//! 0.05 x 0.10 m block of right triangles, every triangle with its own nodes, an
+//! intrinsic cohesive joint on every interior edge (penalties 10 E, overlap 100 E,
+//! Ts = 2 MPa, c = 10 MPa), E = 30 GPa, nu = 0.25, rho = 2600, bottom fixed in y, top
+//! pushed at 0.05 m/s, dt = 0.05 h / c_p; 10k, 50k and 200k triangles, 1 thread and all
+//! threads. Rows `..._joints_...` leave contact out; rows `..._contact_...` are the
 //! full scene with contact on (penalty 10 E, friction 30° with shear penalty 10 E,
 //! bonded neighbours excluded until their joint breaks), 10k and 50k triangles.
 //!

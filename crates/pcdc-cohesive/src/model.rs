@@ -794,7 +794,7 @@ mod tests {
     const H: f64 = 0.002;
 
     fn czm() -> IntrinsicCzm {
-        // UCS quick-start joints (VALIDATION.md scene 8) with E = 30 GPa.
+        // UCS quick-start joints (scene 8 of docs/validation-scenes.md) with E = 30 GPa.
         IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, 300e9, 300e9, 3000e9).unwrap()
     }
 

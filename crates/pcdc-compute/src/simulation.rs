@@ -1,10 +1,10 @@
 //! The simulation: builder, explicit central-difference stepping, stable time step,
 //! divergence watchdog and energies (save/restore: [`crate::snapshot`]).
 //!
-//! One mechanical step (DESIGN.md): clear slots; every physics computes its forces into
-//! its own slots; each node sums its slots in a fixed order; central-difference update
-//! with lumped mass and gravity, `v += dt (F/m + g)` (manual 7.1 eq. iv); prescribed
-//! kinematics; `u += dt v` (eq. v); watchdog.
+//! One mechanical step (`docs/design-targets.md` of the workspace): clear slots; every
+//! physics computes its forces into its own slots; each node sums its slots in a fixed
+//! order; central-difference update with lumped mass and gravity, `v += dt (F/m + g)`
+//! (manual 7.1 eq. iv); prescribed kinematics; `u += dt v` (eq. v); watchdog.
 
 use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;

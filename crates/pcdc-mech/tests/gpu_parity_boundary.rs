@@ -19,7 +19,7 @@ use pcdc_compute::{
 use pcdc_mech::{Boundary, Constraint, FaceStress, LinearElastic, Mechanics, ACCEL_VELOCITY};
 use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh, Range};
 
-/// The parity bar of the design guide.
+/// The GPU-CPU parity bar (docs/design-targets.md).
 const TOL: f64 = 1e-12;
 
 /// Test physics: every node gets `mass` (kg); no forces, no kernels.

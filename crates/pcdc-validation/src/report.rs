@@ -1,5 +1,6 @@
-//! The `RESULT` line every validation scene ends with (DESIGN.md), the backend choice
-//! of the validation examples, and output folders.
+//! The `RESULT` line every validation scene ends with (its format and each example's
+//! metrics: `docs/design-targets.md`), the backend choice of the validation examples,
+//! and output folders.
 
 use std::fmt;
 use std::path::PathBuf;

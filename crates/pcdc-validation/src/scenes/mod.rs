@@ -1,6 +1,7 @@
-//! Validation scenes of `VALIDATION.md`: each runs a model, compares it with a closed
-//! form and returns the measured error. Examples run them at full size and print the
-//! `RESULT` line; tests run them at reduced size and assert the same tolerance.
+//! Validation scenes, specified in `docs/validation-scenes.md`: each runs a model,
+//! compares it with a closed form and returns the measured error. Examples run them at
+//! full size and print the `RESULT` line; tests run them at reduced size and assert the
+//! same tolerance.
 //!
 //! The laboratory tests [`ucs`] and [`brazilian`] share one platen-test set-up
 //! ([`platen_test`]) and can be written as TOML scene files ([`file`](mod@file)); their upper

@@ -20,7 +20,7 @@
 //! peak. In plane strain a free-sided sample under axial stress σ strains by
 //! (1 − ν²) σ / E, so Young's modulus is the slope times (1 − ν²). Acceptance:
 //! that modulus within 5 % of the input E and UCS / T_s in the rock-like range 5–20
-//! (`VALIDATION.md`).
+//! (scene 8 of `docs/validation-scenes.md`).
 //!
 //! The joints are springs of stiffness P / h in series with the elements, so the sample
 //! is softer than E by a penalty compliance that [`jointed_modulus`] gives in closed
