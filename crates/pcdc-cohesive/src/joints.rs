@@ -397,7 +397,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         Some(format!("joint {}", slot / (2 * D::NODES_PER_FACE)))
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let [sid, did, bid] = self.ids.expect("init ran");
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let stride = self.state_stride();

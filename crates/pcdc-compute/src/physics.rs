@@ -167,11 +167,11 @@ pub trait Physics<D: Dim>: Send + Sync {
     }
 
     /// Computes this physics' forces into its slots (and updates its fields).
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError>;
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError>;
 
     /// Imposes prescribed velocities, accelerations and constraints on the freshly
     /// integrated velocities.
-    fn apply_kinematics(&self, _ctx: &mut VelocityContext<'_, D>) {}
+    fn apply_kinematics(&mut self, _ctx: &mut VelocityContext<'_, D>) {}
 
     /// Adds the linear (small-displacement) stiffness of this physics as triplets
     /// `(row dof, col dof, value)`, dof = node * D + component, for the direct static

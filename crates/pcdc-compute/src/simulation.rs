@@ -463,7 +463,7 @@ impl<D: Dim> Simulation<D> {
         let kin_v = &self.state.v;
         let fields = &mut self.state.fields;
         self.slot_forces.fill(0.0);
-        for (p, r) in self.physics.iter().zip(&self.slot_ranges) {
+        for (p, r) in self.physics.iter_mut().zip(&self.slot_ranges) {
             let mut ctx = ForceContext {
                 kin: Kinematics {
                     mesh: &self.mesh,
@@ -531,7 +531,7 @@ impl<D: Dim> Simulation<D> {
         let d = D::D;
         let dt = self.dt;
         let t_end = self.state.time + dt;
-        for p in &self.physics {
+        for p in &mut self.physics {
             let mut ctx = VelocityContext {
                 mesh: &self.mesh,
                 u: &self.state.u,

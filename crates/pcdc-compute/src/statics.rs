@@ -80,7 +80,7 @@ impl<D: Dim> Simulation<D> {
         let probe_value = 1.234_567e-3;
         let mut v = vec![probe_value; self.state.v.len()];
         let mut fields = self.state.fields.clone();
-        for p in &self.physics {
+        for p in &mut self.physics {
             let mut ctx = crate::physics::VelocityContext {
                 mesh: &self.mesh,
                 u: &self.state.u,

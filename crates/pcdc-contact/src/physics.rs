@@ -865,7 +865,7 @@ impl<D: Dim> Physics<D> for Contact {
         })
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let rid = self.reference.expect("init ran");
         let ns = self.n_state;
         let kin = &ctx.kin;

@@ -23,7 +23,7 @@ impl Physics<Dim2> for BondFlags {
     fn init(&mut self, _ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
         Ok(())
     }
-    fn compute_forces(&self, _ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, _ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
         Ok(())
     }
 }

@@ -23,7 +23,7 @@ impl Physics<Dim3> for BondFlags {
     fn init(&mut self, _ctx: &mut InitContext<'_, Dim3>) -> Result<(), ComputeError> {
         Ok(())
     }
-    fn compute_forces(&self, _ctx: &mut ForceContext<'_, Dim3>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, _ctx: &mut ForceContext<'_, Dim3>) -> Result<(), ComputeError> {
         Ok(())
     }
 }

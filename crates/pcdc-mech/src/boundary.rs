@@ -350,7 +350,7 @@ impl<D: Dim> Physics<D> for Boundary {
         Ok(())
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let d = D::D;
         let t = ctx.kin.time;
         for (it, r) in self.items.iter().zip(&self.resolved) {
@@ -397,7 +397,7 @@ impl<D: Dim> Physics<D> for Boundary {
         Ok(())
     }
 
-    fn apply_kinematics(&self, ctx: &mut VelocityContext<'_, D>) {
+    fn apply_kinematics(&mut self, ctx: &mut VelocityContext<'_, D>) {
         let d = D::D;
         // Velocities are at the half step t - dt/2.
         let th = ctx.time - 0.5 * ctx.dt;

@@ -615,7 +615,7 @@ impl<D: Dim> Physics<D> for Mechanics {
         })
     }
 
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let ids = self.ids();
         let (d, npe, nsym) = (D::D, D::NODES_PER_ELEM, D::NSYM);
         let nx = if d == 2 { 1 } else { 9 };

@@ -106,7 +106,7 @@ impl<D: Dim> Physics<D> for AntiDamper {
         self.slots = Some(ctx.register_slots(&nodes)?);
         Ok(())
     }
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         for (i, f) in ctx.slots.iter_mut().enumerate() {
             *f = self.c * ctx.kin.mass[i / D::D] * ctx.kin.v[i];
         }

@@ -48,7 +48,7 @@ impl<D: Dim> Physics<D> for PointMass {
         }
     }
 
-    fn compute_forces(&self, _ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, _ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         Ok(())
     }
 

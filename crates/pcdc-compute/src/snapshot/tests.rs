@@ -62,7 +62,7 @@ impl Physics<Dim2> for Springs {
             physics: "springs".into(),
         })
     }
-    fn compute_forces(&self, ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
         for (s, u) in ctx.slots.iter_mut().zip(ctx.kin.u) {
             *s = -self.k * u;
         }
@@ -339,7 +339,7 @@ impl Physics<Dim2> for Quiet {
     fn init(&mut self, _ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
         Ok(())
     }
-    fn compute_forces(&self, _ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
+    fn compute_forces(&mut self, _ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
         Ok(())
     }
 }
