@@ -25,9 +25,10 @@
 use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
+use pcdc_compute::{Components, FieldKey, FieldUse, Place};
 use pcdc_compute::{
-    ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
-    Kinematics, Location, Physics, StableStep,
+    ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
+    StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
@@ -38,11 +39,13 @@ const JOINT_KERNEL: &str = include_str!("shaders/joints.wgsl");
 const JOINT_LIBRARY: &str = include_str!("shaders/joint_library.wgsl");
 
 /// Name of the joint history field.
-pub const JOINT_STATE: &str = "joint_state";
+pub const JOINT_STATE: FieldKey =
+    FieldKey::new("joint_state", Place::Entities, Components::Declared);
 /// Name of the per-joint damage field (largest D over the Gauss points).
-pub const JOINT_DAMAGE: &str = "joint_damage";
+pub const JOINT_DAMAGE: FieldKey =
+    FieldKey::new("joint_damage", Place::Entities, Components::Fixed(1));
 /// Name of the face field flagging the faces of broken joints (1 = broken).
-pub const BROKEN_FACE: &str = "broken_face";
+pub const BROKEN_FACE: FieldKey = FieldKey::new("broken_face", Place::Face, Components::Fixed(1));
 
 const CHUNK: usize = 256;
 
@@ -238,14 +241,14 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
             .finish()
     }
 
-    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
         let points = if D::D == 2 { 3 } else { self.gauss_3d };
         let ns = self.assigned_state_len();
         let nj = self.joints.len();
         vec![
-            FieldSpec::new(JOINT_STATE, Location::Entities(nj), points * ns),
-            FieldSpec::new(JOINT_DAMAGE, Location::Entities(nj), 1),
-            FieldSpec::new(BROKEN_FACE, Location::Face, 1),
+            JOINT_STATE.own_sized::<D>(Some(nj), Some(points * ns)),
+            JOINT_DAMAGE.own_sized::<D>(Some(nj), None),
+            BROKEN_FACE.own::<D>(),
         ]
     }
 

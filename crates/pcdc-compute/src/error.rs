@@ -20,6 +20,30 @@ pub enum ComputeError {
     /// Two physics declare the same field with different layouts.
     #[error("field '{name}' declared twice with different layouts ({a} and {b})")]
     FieldConflict { name: String, a: String, b: String },
+    /// Two physics own the same field (e.g. the same physics composed twice).
+    #[error("field '{field}' has two owners: physics '{first}' and physics '{second}' (a field has exactly one owner; compose each physics once)")]
+    FieldOwnedTwice {
+        field: String,
+        first: String,
+        second: String,
+    },
+    /// A physics uses a field that no composed physics owns.
+    #[error("physics '{physics}' {verb} field '{field}', but no composed physics owns it (compose the physics that provides it)")]
+    FieldWithoutOwner {
+        field: String,
+        physics: String,
+        verb: &'static str,
+    },
+    /// A physics reads a field's current value before the physics that writes it runs.
+    #[error("physics '{reader}' reads field '{field}' of the current step but runs before physics '{writer}', which writes it: add '{writer}' first (or read the previous step's value with read_lagged)")]
+    FieldReadBeforeWrite {
+        field: String,
+        reader: String,
+        writer: String,
+    },
+    /// A physics that may be composed only once was composed twice.
+    #[error("physics '{0}' is composed twice; it may be composed only once (give one instance all its materials and ranges)")]
+    DuplicatePhysics(String),
     /// A field was requested that no composed physics declared.
     #[error("no field named '{0}' (declared fields: {1})")]
     UnknownField(String, String),

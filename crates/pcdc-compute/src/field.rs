@@ -1,25 +1,267 @@
 //! Field storage: one contiguous `f64` array per declared field.
 //!
 //! Only the fields that the composed physics declare are allocated: a scene with no
-//! fluid carries no fluid arrays. Physics look fields up once by name at build time and
-//! keep the [`FieldId`].
+//! fluid carries no fluid arrays. Every field has exactly one owner: a physics states
+//! for each field it touches whether it owns, writes or reads it ([`FieldUse`], built
+//! from a typed [`FieldKey`]); the simulation builder refuses a field with two owners,
+//! a field used without an owner, and a reader that runs before the field's writers.
+//! Physics look fields up once at build time and keep the [`FieldId`].
 
 use serde::{Deserialize, Serialize};
 
+use pcdc_mesh::{Dim, Mesh};
+
 use crate::ComputeError;
 
-/// Well-known field names shared between physics crates.
+/// Well-known fields shared between physics crates: typed keys, so a reader in one crate
+/// and the owner in another agree on the name and the layout without depending on each
+/// other. A crate declares the keys of its private fields itself.
 pub mod names {
-    /// Element Cauchy stress (Pa), symmetric tensor, stride NSYM.
-    pub const STRESS: &str = "stress";
-    /// Element out-of-plane stress σzz in plane strain (Pa), 2D only.
-    pub const STRESS_ZZ: &str = "stress_zz";
-    /// Element strain in the co-rotated frame, symmetric tensor (engineering shear not used: tensor components).
-    pub const STRAIN: &str = "strain";
-    /// Element rotation of the co-rotated frame: 2D angle (rad) or 3D rotation matrix (9, row-major).
-    pub const ROTATION: &str = "rotation";
+    use super::{Components, FieldKey, Place};
+
+    /// Element Cauchy stress (Pa), symmetric tensor, stride NSYM. Owner: mechanics.
+    pub const STRESS: FieldKey = FieldKey::new("stress", Place::Element, Components::Sym);
+    /// Element out-of-plane stress σzz in plane strain (Pa), 2D only. Owner: mechanics.
+    pub const STRESS_ZZ: FieldKey =
+        FieldKey::new("stress_zz", Place::Element, Components::Fixed(1));
+    /// Element strain in the co-rotated frame, symmetric tensor (tensor components, not
+    /// engineering shear). Owner: mechanics.
+    pub const STRAIN: FieldKey = FieldKey::new("strain", Place::Element, Components::Sym);
+    /// Element rotation of the co-rotated frame: 2D angle (rad) or 3D rotation matrix (9,
+    /// row-major). Owner: mechanics.
+    pub const ROTATION: FieldKey = FieldKey::new("rotation", Place::Element, Components::Declared);
     /// Element constitutive state variables (model-defined, fixed count per element).
-    pub const MODEL_STATE: &str = "model_state";
+    /// Owner: mechanics.
+    pub const MODEL_STATE: FieldKey =
+        FieldKey::new("model_state", Place::Element, Components::Declared);
+}
+
+/// Where a field key lives (the entity count of [`Place::Entities`] is given by the
+/// owner when it declares the field).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Place {
+    /// One value set per mesh node.
+    Node,
+    /// One value set per element.
+    Element,
+    /// One value set per face.
+    Face,
+    /// One value set per entity of a physics-defined set (e.g. joints).
+    Entities,
+}
+
+/// Values per entity of a field key.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Components {
+    /// A fixed count.
+    Fixed(usize),
+    /// One per dimension (a vector).
+    Vector,
+    /// The independent components of a symmetric tensor (3 in 2D, 6 in 3D).
+    Sym,
+    /// Chosen by the owner when it declares the field (e.g. model state variables).
+    Declared,
+}
+
+impl Components {
+    fn resolve<D: Dim>(self) -> Option<usize> {
+        match self {
+            Components::Fixed(n) => Some(n),
+            Components::Vector => Some(D::D),
+            Components::Sym => Some(D::NSYM),
+            Components::Declared => None,
+        }
+    }
+}
+
+/// A typed field key: the name and the layout of a field, declared as a `const` by the
+/// crate that owns the field (or in [`names`] for fields several crates share). A
+/// physics states how it uses each field with [`FieldKey::own`], [`FieldKey::write`],
+/// [`FieldKey::read`] or [`FieldKey::read_lagged`] in [`crate::Physics::fields`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FieldKey {
+    name: &'static str,
+    place: Place,
+    components: Components,
+}
+
+impl FieldKey {
+    /// A key.
+    pub const fn new(name: &'static str, place: Place, components: Components) -> Self {
+        FieldKey {
+            name,
+            place,
+            components,
+        }
+    }
+
+    /// The field's name.
+    pub const fn name(&self) -> &'static str {
+        self.name
+    }
+
+    /// Where the field lives.
+    pub const fn place(&self) -> Place {
+        self.place
+    }
+
+    /// Values per entity, as declared by the key.
+    pub const fn components(&self) -> Components {
+        self.components
+    }
+
+    fn usage<D: Dim>(self, access: FieldAccess) -> FieldUse {
+        FieldUse {
+            name: self.name.to_string(),
+            place: Some(self.place),
+            entities: None,
+            components: self.components.resolve::<D>(),
+            initial: 0.0,
+            access,
+        }
+    }
+
+    /// This physics owns the field: it declares it (allocated, initial value 0), writes
+    /// it, and is the only one that may own it. For [`Place::Entities`] or
+    /// [`Components::Declared`] keys use [`FieldKey::own_sized`].
+    pub fn own<D: Dim>(self) -> FieldUse {
+        self.usage::<D>(FieldAccess::Own)
+    }
+
+    /// Owns a field whose entity count ([`Place::Entities`]) or component count
+    /// ([`Components::Declared`]) only the owner knows.
+    pub fn own_sized<D: Dim>(self, entities: Option<usize>, components: Option<usize>) -> FieldUse {
+        let mut u = self.usage::<D>(FieldAccess::Own);
+        u.entities = entities;
+        if components.is_some() {
+            u.components = components;
+        }
+        u
+    }
+
+    /// This physics writes a field another physics owns (e.g. a reset), within the step.
+    pub fn write<D: Dim>(self) -> FieldUse {
+        self.usage::<D>(FieldAccess::Write)
+    }
+
+    /// This physics reads the field's value of the current step: its owner and writers
+    /// must run before it.
+    pub fn read<D: Dim>(self) -> FieldUse {
+        self.usage::<D>(FieldAccess::Read)
+    }
+
+    /// This physics reads the field's value as left by the previous step (no order
+    /// constraint: an explicit coupling lagged by one step).
+    pub fn read_lagged<D: Dim>(self) -> FieldUse {
+        self.usage::<D>(FieldAccess::ReadLagged)
+    }
+}
+
+impl std::fmt::Display for FieldKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
+
+impl AsRef<str> for FieldKey {
+    fn as_ref(&self) -> &str {
+        self.name
+    }
+}
+
+/// How a physics uses a field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FieldAccess {
+    /// Declares and writes the field; exactly one physics owns each field.
+    Own,
+    /// Writes a field another physics owns.
+    Write,
+    /// Reads the current step's value (runs after the owner and the writers).
+    Read,
+    /// Reads the previous step's value (no order constraint).
+    ReadLagged,
+}
+
+impl FieldAccess {
+    /// `owns`, `writes`, `reads`, `reads (lagged)`.
+    pub fn verb(self) -> &'static str {
+        match self {
+            FieldAccess::Own => "owns",
+            FieldAccess::Write => "writes",
+            FieldAccess::Read => "reads",
+            FieldAccess::ReadLagged => "reads (lagged)",
+        }
+    }
+}
+
+/// One physics' use of one field, as returned by [`crate::Physics::fields`]. For an
+/// owner the layout is complete; for other uses the parts that are known are checked
+/// against the owner's declaration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldUse {
+    /// Field name.
+    pub name: String,
+    /// Where it lives (`None`: not checked, for a field named at run time).
+    pub place: Option<Place>,
+    /// Entity count of a [`Place::Entities`] field (owner only).
+    pub entities: Option<usize>,
+    /// Values per entity (`None`: not checked, or not yet known).
+    pub components: Option<usize>,
+    /// Initial value of every component (owner only).
+    pub initial: f64,
+    /// How the physics uses it.
+    pub access: FieldAccess,
+}
+
+impl FieldUse {
+    /// A use of a field known only by its name (e.g. a field a user names in a
+    /// parameter); its layout is taken from the owner.
+    pub fn named(name: &str, access: FieldAccess) -> Self {
+        FieldUse {
+            name: name.to_string(),
+            place: None,
+            entities: None,
+            components: None,
+            initial: 0.0,
+            access,
+        }
+    }
+
+    /// Sets the initial value of an owned field (e.g. NaN for "not yet set").
+    pub fn initial(mut self, value: f64) -> Self {
+        self.initial = value;
+        self
+    }
+
+    /// The declaration of an owned field, with the entity counts of `mesh`.
+    pub(crate) fn spec<D: Dim>(&self, mesh: &Mesh<D>) -> Result<(FieldSpec, usize), ComputeError> {
+        let missing = |what: &str| {
+            ComputeError::param(
+                format!("field '{}'", self.name),
+                what,
+                "its owner must give it (FieldKey::own_sized)",
+            )
+        };
+        let components = self.components.ok_or_else(|| missing("component count"))?;
+        let (location, count) = match self.place.ok_or_else(|| missing("place"))? {
+            Place::Node => (Location::Node, mesh.n_nodes()),
+            Place::Element => (Location::Element, mesh.n_elements()),
+            Place::Face => (Location::Face, mesh.faces().len()),
+            Place::Entities => {
+                let n = self.entities.ok_or_else(|| missing("entity count"))?;
+                (Location::Entities(n), n)
+            }
+        };
+        Ok((
+            FieldSpec {
+                name: self.name.clone(),
+                location,
+                components,
+                initial: self.initial,
+            },
+            count,
+        ))
+    }
 }
 
 /// Where a field lives.
@@ -98,8 +340,9 @@ impl FieldStore {
         Ok(FieldId(self.specs.len() - 1))
     }
 
-    /// The handle of a declared field.
-    pub fn id(&self, name: &str) -> Result<FieldId, ComputeError> {
+    /// The handle of a declared field, by name or by [`FieldKey`].
+    pub fn id(&self, name: impl AsRef<str>) -> Result<FieldId, ComputeError> {
+        let name = name.as_ref();
         self.specs
             .iter()
             .position(|s| s.name == name)

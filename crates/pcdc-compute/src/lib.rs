@@ -38,7 +38,10 @@ mod table;
 pub use backend::{Backend, BackendChoice, BackendKind, CpuBackend, Precision};
 pub use energy::{EnergyBalance, PhysicsEnergy, ENERGY_CHECK_EVERY};
 pub use error::ComputeError;
-pub use field::{names, FieldId, FieldSpec, FieldStore, Location};
+pub use field::{
+    names, Components, FieldAccess, FieldId, FieldKey, FieldSpec, FieldStore, FieldUse, Location,
+    Place,
+};
 pub use fingerprint::Fingerprint;
 #[cfg(feature = "gpu")]
 pub use gpu::WgpuBackend;

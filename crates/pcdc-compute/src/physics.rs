@@ -8,7 +8,7 @@
 
 use pcdc_mesh::{Dim, Mesh};
 
-use crate::{Backend, ComputeError, FieldSpec, FieldStore};
+use crate::{Backend, ComputeError, FieldStore, FieldUse};
 
 /// Handle to a block of force slots registered by a physics.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -139,9 +139,18 @@ pub trait Physics<D: Dim>: Send + Sync {
     /// Name used in reports and errors.
     fn name(&self) -> &str;
 
-    /// Fields this physics reads or writes (allocated before [`Physics::init`]).
-    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
+    /// The fields this physics owns, writes and reads ([`crate::FieldKey::own`],
+    /// [`crate::FieldKey::read`], ...). Owned fields are allocated before
+    /// [`Physics::init`]; the builder checks that every field has exactly one owner and
+    /// that a reader of the current step's value runs after the field's writers.
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
         Vec::new()
+    }
+
+    /// Whether this physics may be composed only once in a simulation (e.g. element
+    /// mechanics: a second instance would add the element forces twice). Default: no.
+    fn unique(&self) -> bool {
+        false
     }
 
     /// Validates the physics against the mesh, derives constant data, registers force

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use crate::energy::EnergyTracker;
 use crate::gpu::GpuRun;
 use crate::physics::{ForceContext, InitContext, Kinematics, VelocityContext};
-use crate::{Backend, ComputeError, FieldStore, Physics, StableStep};
+use crate::{Backend, ComputeError, FieldAccess, FieldStore, Physics, StableStep};
 
 /// Default safety factor applied to the critical time step.
 pub const DEFAULT_SAFETY: f64 = 0.5;
@@ -269,6 +269,93 @@ pub(crate) struct Layout {
     pub gather_idx: Vec<u32>,
 }
 
+/// Checks the composition's field uses (one owner per field, no use without an owner,
+/// readers after writers, unique physics once) and declares the owned fields in the
+/// order of their owners.
+fn declare_fields<D: Dim>(
+    mesh: &Mesh<D>,
+    physics: &[Box<dyn Physics<D>>],
+) -> Result<FieldStore, ComputeError> {
+    for (i, p) in physics.iter().enumerate() {
+        if p.unique() && physics[..i].iter().any(|q| q.name() == p.name()) {
+            return Err(ComputeError::DuplicatePhysics(p.name().to_string()));
+        }
+    }
+    let uses: Vec<Vec<crate::FieldUse>> = physics.iter().map(|p| p.fields(mesh)).collect();
+    let mut fields = FieldStore::default();
+    let mut owner: std::collections::HashMap<&str, usize> = std::collections::HashMap::new();
+    for (i, list) in uses.iter().enumerate() {
+        for u in list.iter().filter(|u| u.access == FieldAccess::Own) {
+            if let Some(&j) = owner.get(u.name.as_str()) {
+                return Err(ComputeError::FieldOwnedTwice {
+                    field: u.name.clone(),
+                    first: physics[j].name().to_string(),
+                    second: physics[i].name().to_string(),
+                });
+            }
+            owner.insert(&u.name, i);
+            let (spec, count) = u.spec(mesh)?;
+            fields.declare(spec, count)?;
+        }
+    }
+    for (i, list) in uses.iter().enumerate() {
+        for u in list.iter().filter(|u| u.access != FieldAccess::Own) {
+            let Some(&o) = owner.get(u.name.as_str()) else {
+                return Err(ComputeError::FieldWithoutOwner {
+                    field: u.name.clone(),
+                    physics: physics[i].name().to_string(),
+                    verb: u.access.verb(),
+                });
+            };
+            let spec = fields.spec(fields.id(&u.name)?);
+            let place_ok = u.place.is_none_or(|p| {
+                matches!(
+                    (p, spec.location),
+                    (crate::Place::Node, crate::Location::Node)
+                        | (crate::Place::Element, crate::Location::Element)
+                        | (crate::Place::Face, crate::Location::Face)
+                        | (crate::Place::Entities, crate::Location::Entities(_))
+                )
+            });
+            if !place_ok || u.components.is_some_and(|c| c != spec.components) {
+                return Err(ComputeError::FieldConflict {
+                    name: u.name.clone(),
+                    a: format!(
+                        "{:?}x{} (owned by '{}')",
+                        spec.location,
+                        spec.components,
+                        physics[o].name()
+                    ),
+                    b: format!(
+                        "{:?}x{:?} ({} by '{}')",
+                        u.place,
+                        u.components,
+                        u.access.verb(),
+                        physics[i].name()
+                    ),
+                });
+            }
+            if u.access == FieldAccess::Read {
+                // Every writer (the owner included) must come before the reader.
+                let writers = uses.iter().enumerate().filter(|(j, l)| {
+                    l.iter().any(|w| {
+                        w.name == u.name
+                            && matches!(w.access, FieldAccess::Own | FieldAccess::Write)
+                    }) && *j > i
+                });
+                if let Some((j, _)) = writers.into_iter().next() {
+                    return Err(ComputeError::FieldReadBeforeWrite {
+                        field: u.name.clone(),
+                        reader: physics[i].name().to_string(),
+                        writer: physics[j].name().to_string(),
+                    });
+                }
+            }
+        }
+    }
+    Ok(fields)
+}
+
 /// Declares the fields of every physics, initialises them in order (registering their
 /// slots) and builds the CSR node -> slots lists (slots in registration order).
 pub(crate) fn prepare_layout<D: Dim>(
@@ -276,18 +363,8 @@ pub(crate) fn prepare_layout<D: Dim>(
     physics: &mut [Box<dyn Physics<D>>],
 ) -> Result<Layout, ComputeError> {
     let n_nodes = mesh.n_nodes();
-    let mut fields = FieldStore::default();
-    for p in physics.iter() {
-        for spec in p.fields(mesh) {
-            let count = match spec.location {
-                crate::Location::Node => n_nodes,
-                crate::Location::Element => mesh.n_elements(),
-                crate::Location::Face => mesh.faces().len(),
-                crate::Location::Entities(n) => n,
-            };
-            fields.declare(spec, count)?;
-        }
-    }
+    let fields = declare_fields(mesh, physics)?;
+    let mut fields = fields;
     let mut slot_ranges = Vec::with_capacity(physics.len());
     let mut slot_nodes = Vec::new();
     for p in physics.iter_mut() {
@@ -723,7 +800,7 @@ impl<D: Dim> Simulation<D> {
     }
 
     /// Values of a field by name.
-    pub fn field(&self, name: &str) -> Result<&[f64], ComputeError> {
+    pub fn field(&self, name: impl AsRef<str>) -> Result<&[f64], ComputeError> {
         let id = self.state.fields.id(name)?;
         Ok(self.state.fields.get(id))
     }

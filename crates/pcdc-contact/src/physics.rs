@@ -37,9 +37,10 @@
 
 use std::sync::Mutex;
 
+use pcdc_compute::{Components, FieldAccess, FieldKey, FieldUse, Place};
 use pcdc_compute::{
-    ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
-    Kinematics, Location, Physics, StableStep,
+    ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
+    StableStep,
 };
 use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;
@@ -50,7 +51,11 @@ use crate::model::{ContactDamping, ContactModel, Friction, MohrCoulombContact};
 use crate::{tet_pair_force, triangle_pair_force, PairForce2, PairForce3};
 
 /// Node positions at the last broad-phase build (m), stride D.
-pub const CONTACT_REFERENCE: &str = "contact_reference_positions";
+pub const CONTACT_REFERENCE: FieldKey = FieldKey::new(
+    "contact_reference_positions",
+    Place::Node,
+    Components::Vector,
+);
 
 /// The error of a lock poisoned by an earlier panic.
 fn poisoned_state() -> ComputeError {
@@ -310,7 +315,13 @@ impl Contact {
     /// `pcdc_cohesive::split_nodes`: `joints.elements`, every other entry of
     /// `joints.faces`, and `pcdc_cohesive::BROKEN_FACE`, so broken joint faces become
     /// contact faces.
-    pub fn bonded_pairs(mut self, elements: &[u32], faces: &[u32], broken_field: &str) -> Self {
+    pub fn bonded_pairs(
+        mut self,
+        elements: &[u32],
+        faces: &[u32],
+        broken_field: impl AsRef<str>,
+    ) -> Self {
+        let broken_field = broken_field.as_ref();
         self.bonds = Some(Bonds {
             elements: elements.to_vec(),
             faces: faces.to_vec(),
@@ -706,11 +717,18 @@ impl<D: Dim> Physics<D> for Contact {
         "contact"
     }
 
-    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
-        let mut spec = FieldSpec::new(CONTACT_REFERENCE, Location::Node, D::D);
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
         // NaN forces a build at the first step (and after a restore of an older state).
-        spec.initial = f64::NAN;
-        vec![spec]
+        let mut uses = vec![CONTACT_REFERENCE.own::<D>().initial(f64::NAN)];
+        if let Some(b) = &self.bonds {
+            // The broken-bond flags of the current step (written by the joints).
+            uses.push(FieldUse {
+                place: Some(Place::Face),
+                components: Some(1),
+                ..FieldUse::named(&b.field, FieldAccess::Read)
+            });
+        }
+        uses
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
@@ -799,7 +817,7 @@ impl<D: Dim> Physics<D> for Contact {
                 .as_ref()
                 .map(|b| (b.per_element.as_slice(), b.field.as_str())),
             capacity: self.gpu_capacity,
-            reference: CONTACT_REFERENCE,
+            reference: CONTACT_REFERENCE.name(),
         };
         crate::gpu::setup(input, setup)
     }

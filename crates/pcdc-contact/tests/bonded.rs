@@ -2,13 +2,14 @@
 //! other until the bond's broken flag is set; then the pair pushes apart.
 
 use pcdc_compute::{
-    Backend, ComputeError, FieldSpec, ForceContext, InitContext, Location, Physics, Simulation,
+    Backend, Components, ComputeError, FieldKey, FieldUse, ForceContext, InitContext, Physics,
+    Place, Simulation,
 };
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{Dim2, Mesh, Range};
 
-const FLAG: &str = "bond_broken";
+const FLAG: FieldKey = FieldKey::new("bond_broken", Place::Face, Components::Fixed(1));
 
 /// Declares the broken-bond face field (what pcdc-cohesive publishes as `broken_face`).
 struct BondFlags;
@@ -17,8 +18,8 @@ impl Physics<Dim2> for BondFlags {
     fn name(&self) -> &str {
         "bond flags"
     }
-    fn fields(&self, _mesh: &Mesh<Dim2>) -> Vec<FieldSpec> {
-        vec![FieldSpec::new(FLAG, Location::Face, 1)]
+    fn fields(&self, _mesh: &Mesh<Dim2>) -> Vec<FieldUse> {
+        vec![FLAG.own::<Dim2>()]
     }
     fn init(&mut self, _ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
         Ok(())
@@ -80,9 +81,9 @@ fn bad_bond_input_is_an_error() {
     let mesh = Mesh::<Dim2>::new(coords, vec![0, 1, 2, 3, 4, 5]).unwrap();
     let rock = LinearElastic::new(1e9, 0.25, 1000.0).unwrap();
     for (el, fa, field) in [
-        (vec![0, 1], vec![99], FLAG),
-        (vec![0, 7], vec![0], FLAG),
-        (vec![0, 1, 1], vec![0], FLAG),
+        (vec![0, 1], vec![99], FLAG.name()),
+        (vec![0, 7], vec![0], FLAG.name()),
+        (vec![0, 1, 1], vec![0], FLAG.name()),
         (vec![0, 1], vec![0], "no_such_field"),
     ] {
         let r = Simulation::builder(mesh.clone(), Backend::cpu(1).unwrap())

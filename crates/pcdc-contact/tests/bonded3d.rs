@@ -2,13 +2,14 @@
 //! broken flag is set; then the pair pushes apart (the 3D form of tests/bonded.rs).
 
 use pcdc_compute::{
-    Backend, ComputeError, FieldSpec, ForceContext, InitContext, Location, Physics, Simulation,
+    Backend, Components, ComputeError, FieldKey, FieldUse, ForceContext, InitContext, Physics,
+    Place, Simulation,
 };
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{Dim3, Mesh, Range};
 
-const FLAG: &str = "bond_broken";
+const FLAG: FieldKey = FieldKey::new("bond_broken", Place::Face, Components::Fixed(1));
 
 /// Declares the broken-bond face field (what pcdc-cohesive publishes as `broken_face`).
 struct BondFlags;
@@ -17,8 +18,8 @@ impl Physics<Dim3> for BondFlags {
     fn name(&self) -> &str {
         "bond flags"
     }
-    fn fields(&self, _mesh: &Mesh<Dim3>) -> Vec<FieldSpec> {
-        vec![FieldSpec::new(FLAG, Location::Face, 1)]
+    fn fields(&self, _mesh: &Mesh<Dim3>) -> Vec<FieldUse> {
+        vec![FLAG.own::<Dim3>()]
     }
     fn init(&mut self, _ctx: &mut InitContext<'_, Dim3>) -> Result<(), ComputeError> {
         Ok(())

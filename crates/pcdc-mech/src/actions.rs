@@ -2,12 +2,14 @@
 //! state. Also used to give nodes an initial velocity.
 
 use pcdc_compute::{names, Simulation};
+use pcdc_compute::{Components, FieldKey, Place};
 use pcdc_mesh::{Dim, Range};
 
 use crate::MechError;
 
 /// Name of the node field that stores the displacement at the last reset.
-pub const DISPLACEMENT_RESET: &str = "displacement_reset";
+pub const DISPLACEMENT_RESET: FieldKey =
+    FieldKey::new("displacement_reset", Place::Node, Components::Vector);
 
 /// Sets the velocity (m/s) of every node in `range` (first `D` components used; on a 2D
 /// mesh a non-zero z component is an error, as it would be ignored).

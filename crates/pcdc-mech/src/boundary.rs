@@ -15,15 +15,20 @@
 
 use pcdc_compute::gpu::{Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
 use pcdc_compute::{
-    ComputeError, DofConstraint, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext,
-    InitContext, Location, Physics, SlotBlock, TimeValue, VelocityContext,
+    ComputeError, DofConstraint, FieldId, FieldStore, Fingerprint, ForceContext, InitContext,
+    Physics, SlotBlock, TimeValue, VelocityContext,
 };
+use pcdc_compute::{FieldKey, FieldUse, Place};
 use pcdc_mesh::{Dim, Mesh, Range};
 
 use crate::MechError;
 
 /// Name of the node field holding velocities integrated from prescribed accelerations.
-pub const ACCEL_VELOCITY: &str = "bc_accel_velocity";
+pub const ACCEL_VELOCITY: FieldKey = FieldKey::new(
+    "bc_accel_velocity",
+    Place::Node,
+    pcdc_compute::Components::Vector,
+);
 
 /// A move constraint (manual table 7).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -285,13 +290,13 @@ impl<D: Dim> Physics<D> for Boundary {
             .finish()
     }
 
-    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
         if self
             .items
             .iter()
             .any(|i| matches!(i, Item::Acceleration { .. }))
         {
-            vec![FieldSpec::new(ACCEL_VELOCITY, Location::Node, D::D)]
+            vec![ACCEL_VELOCITY.own::<D>()]
         } else {
             Vec::new()
         }

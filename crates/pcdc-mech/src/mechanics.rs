@@ -11,9 +11,10 @@
 use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase};
+use pcdc_compute::FieldUse;
 use pcdc_compute::{
-    names, ComputeError, FieldId, FieldSpec, FieldStore, Fingerprint, ForceContext, InitContext,
-    Kinematics, Location, Physics, StableStep,
+    names, ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics,
+    Physics, StableStep,
 };
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
@@ -499,7 +500,7 @@ impl<D: Dim> Physics<D> for Mechanics {
             .finish()
     }
 
-    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldSpec> {
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
         let n_state = self
             .assignments
             .iter()
@@ -507,17 +508,21 @@ impl<D: Dim> Physics<D> for Mechanics {
             .max()
             .unwrap_or(0);
         let extra = if D::D == 2 {
-            FieldSpec::new(names::STRESS_ZZ, Location::Element, 1)
+            names::STRESS_ZZ.own::<D>()
         } else {
-            FieldSpec::new(names::ROTATION, Location::Element, 9)
+            names::ROTATION.own_sized::<D>(None, Some(9))
         };
         vec![
-            FieldSpec::new(names::STRESS, Location::Element, D::NSYM),
-            FieldSpec::new(names::STRAIN, Location::Element, D::NSYM),
+            names::STRESS.own::<D>(),
+            names::STRAIN.own::<D>(),
             extra,
-            FieldSpec::new(names::MODEL_STATE, Location::Element, n_state.max(1)),
-            FieldSpec::new(crate::actions::DISPLACEMENT_RESET, Location::Node, D::D),
+            names::MODEL_STATE.own_sized::<D>(None, Some(n_state.max(1))),
+            crate::actions::DISPLACEMENT_RESET.own::<D>(),
         ]
+    }
+
+    fn unique(&self) -> bool {
+        true
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {

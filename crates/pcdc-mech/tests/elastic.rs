@@ -696,3 +696,20 @@ fn corrupted_snapshots_are_errors() {
         Err(ComputeError::Io { .. })
     ));
 }
+
+/// Mechanics composed twice used to build, run and halve the stress (each instance
+/// added its element forces into one stress field); now it is a build error.
+#[test]
+fn mechanics_composed_twice_is_an_error() {
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    let err = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .build()
+        .err()
+        .expect("two Mechanics must not build");
+    assert!(
+        matches!(&err, ComputeError::DuplicatePhysics(name) if name == "mechanics"),
+        "{err}"
+    );
+}

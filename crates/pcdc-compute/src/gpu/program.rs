@@ -191,7 +191,7 @@ impl<D: Dim> GpuSetup<'_, D> {
     }
 
     /// The device buffer of a declared field (`array<Real>`, same layout as on the host).
-    pub fn field(&self, name: &str) -> Result<GpuBuffer, ComputeError> {
+    pub fn field(&self, name: impl AsRef<str>) -> Result<GpuBuffer, ComputeError> {
         let id = self.fields.id(name)?;
         Ok(GpuBuffer(self.program.field_buffers[id.index()]))
     }

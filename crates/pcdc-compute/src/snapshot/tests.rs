@@ -6,8 +6,12 @@ use pcdc_mesh::{builders, Dim2, Mesh};
 
 use super::*;
 use crate::{
-    Backend, FieldSpec, ForceContext, InitContext, Kinematics, Location, Physics, StableStep,
+    Backend, Components, FieldKey, FieldUse, ForceContext, InitContext, Kinematics, Physics, Place,
+    StableStep,
 };
+
+const SPRING_ENERGY: FieldKey =
+    FieldKey::new("spring_energy", Place::Element, Components::Fixed(1));
 
 /// Every node is tied to its rest position by a spring `k` and carries a mass `rho`;
 /// keeps a counter outside the fields (its `save_state`) that refuses a state of the
@@ -34,8 +38,8 @@ impl Physics<Dim2> for Springs {
     fn name(&self) -> &str {
         "springs"
     }
-    fn fields(&self, _mesh: &Mesh<Dim2>) -> Vec<FieldSpec> {
-        vec![FieldSpec::new("spring_energy", Location::Element, 1)]
+    fn fields(&self, _mesh: &Mesh<Dim2>) -> Vec<FieldUse> {
+        vec![SPRING_ENERGY.own::<Dim2>()]
     }
     fn init(&mut self, ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
         let nodes: Vec<u32> = (0..ctx.mesh.n_nodes() as u32).collect();
