@@ -14,8 +14,8 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use pcdc_cohesive::{
-    czm_state, split_nodes, CohesiveJoints, FailureMode, IntrinsicCzm, BROKEN_FACE, JOINT_DAMAGE,
-    JOINT_STATE,
+    czm_state, split_nodes, CohesiveJoints, FailureMode, IntrinsicCzm, IntrinsicCzmParams,
+    BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE,
 };
 use pcdc_compute::{Backend, BackendKind, Simulation, Table, TimeValue};
 use pcdc_contact::Contact;
@@ -289,16 +289,17 @@ impl JointParams {
 
     /// The intrinsic CZM for a rock of Young's modulus `young` (Pa).
     pub fn model(&self, young: f64) -> Result<IntrinsicCzm, SceneError> {
-        Ok(IntrinsicCzm::new(
-            self.friction_deg,
-            self.cohesion,
-            self.tensile_strength,
-            self.gf1,
-            self.gf2,
-            self.penalty_normal * young,
-            self.penalty_shear * young,
-            self.penalty_overlap * young,
-        )?)
+        Ok(IntrinsicCzmParams {
+            friction_deg: self.friction_deg,
+            cohesion: self.cohesion,
+            tensile_strength: self.tensile_strength,
+            gf1: self.gf1,
+            gf2: self.gf2,
+            penalty_open: self.penalty_normal * young,
+            penalty_shear: self.penalty_shear * young,
+            penalty_overlap: self.penalty_overlap * young,
+        }
+        .build()?)
     }
 }
 
