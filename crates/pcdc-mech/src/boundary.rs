@@ -25,6 +25,32 @@ use crate::MechError;
 /// Name of the node field holding velocities integrated from prescribed accelerations.
 pub const ACCEL_VELOCITY: &str = "bc_accel_velocity";
 
+/// The physics name of [`Boundary`], which also prefixes its errors.
+const NAME: &str = "mechanical boundary";
+
+/// A boundary error as the simulation reports it: named after the boundary physics
+/// (not "mechanics", the element physics of this crate).
+fn boundary_error(e: MechError) -> ComputeError {
+    e.in_physics(NAME)
+}
+
+/// Checks a prescribed value with [`TimeValue::check`]; its invalid-parameter error
+/// becomes the boundary's own, so that it is named after the boundary physics.
+fn check_value(v: &TimeValue, name: &str) -> Result<(), MechError> {
+    v.check(name).map_err(|e| match e {
+        ComputeError::InvalidParameter {
+            name,
+            value,
+            reason,
+        } => MechError::InvalidParameter {
+            name,
+            value,
+            reason,
+        },
+        other => MechError::Compute(other),
+    })
+}
+
 /// A move constraint (manual table 7).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Constraint {
@@ -131,7 +157,7 @@ fn check(values: &Components, what: &str, dim: usize) -> Result<(), MechError> {
                     format!("is prescribed, but the mesh is {dim}D: leave it None"),
                 ));
             }
-            v.check(&format!("{what} component {k}"))?;
+            check_value(v, &format!("{what} component {k}"))?;
         }
     }
     Ok(())
@@ -203,7 +229,7 @@ impl Boundary {
                         ("normal", &stress.normal),
                     ] {
                         if let Some(v) = v {
-                            v.check(&format!("face stress {n}"))?;
+                            check_value(v, &format!("face stress {n}"))?;
                         }
                     }
                 }
@@ -269,7 +295,7 @@ fn unit<D: Dim>(d: &[f64; 3]) -> [f64; 3] {
 
 impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
     fn name(&self) -> &str {
-        "mechanical boundary"
+        NAME
     }
 
     /// Face tractions and node forces are applied loads: external work.
@@ -298,7 +324,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
-        self.validate(D::D)?;
+        self.validate(D::D).map_err(boundary_error)?;
         let mesh = ctx.mesh;
         self.resolved.clear();
         self.accel_field = ctx.fields.id(ACCEL_VELOCITY).ok();
@@ -318,12 +344,11 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
             if let Item::FaceStress { .. } = it {
                 r.faces = mesh.select_boundary_faces(range).map_err(MechError::from)?;
                 if r.faces.is_empty() {
-                    return Err(MechError::EmptyRange {
+                    return Err(boundary_error(MechError::EmptyRange {
                         what: format!("boundary condition {i} ({what})"),
                         range: format!("{range:?}"),
                         entity: "boundary face",
-                    }
-                    .into());
+                    }));
                 }
                 let nodes: Vec<u32> = r
                     .faces
@@ -334,12 +359,11 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
             } else {
                 r.nodes = mesh.select_nodes(range).map_err(MechError::from)?;
                 if r.nodes.is_empty() {
-                    return Err(MechError::EmptyRange {
+                    return Err(boundary_error(MechError::EmptyRange {
                         what: format!("boundary condition {i} ({what})"),
                         range: format!("{range:?}"),
                         entity: "node",
-                    }
-                    .into());
+                    }));
                 }
                 if let Item::NodeForce { .. } = it {
                     r.slots = Some(ctx.register_slots(&r.nodes)?);
@@ -456,9 +480,7 @@ impl<D: Dim, B: Backend> Physics<D, B> for Boundary {
 
     fn gpu_setup(&mut self, setup: &mut GpuSetup<'_, D>) -> Result<(), ComputeError> {
         if self.resolved.len() != self.items.len() {
-            return Err(ComputeError::Gpu(
-                "mechanical boundary: GPU setup before init".to_string(),
-            ));
+            return Err(ComputeError::Gpu(format!("{NAME}: GPU setup before init")));
         }
         let d = D::D as u32;
         let slot0 = setup.slot_first();

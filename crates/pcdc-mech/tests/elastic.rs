@@ -283,6 +283,57 @@ fn invalid_parameters_are_errors() {
     assert!(err.to_string().contains("selects no node"), "{err}");
 }
 
+/// Build errors name the physics they come from: the boundary conditions' errors say
+/// "mechanical boundary" (they used to say "mechanics", pointing the user at the
+/// elements), the elements' errors keep "mechanics".
+#[test]
+fn build_errors_name_their_physics() {
+    let build = |mech: Mechanics, bc: Boundary| {
+        let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        Simulation::builder(mesh, cpu(1))
+            .physics(mech)
+            .physics(bc)
+            .build()
+            .err()
+            .expect("an error")
+            .to_string()
+    };
+    let mech = || Mechanics::new().material(Range::All, rock());
+    for (bc, expect) in [
+        (
+            Boundary::new().fix(Range::rect(5.0, 5.0, 6.0, 6.0)),
+            "mechanical boundary: boundary condition 0 (constraint): the range",
+        ),
+        (
+            Boundary::new().face_stress(Range::group("top"), FaceStress::diagonal(0.0, 1.0, 1.0)),
+            "mechanical boundary: invalid parameter face stress zz",
+        ),
+        (
+            Boundary::new().face_stress(Range::group("top"), FaceStress::normal(f64::NAN)),
+            "mechanical boundary: invalid parameter face stress normal = NaN",
+        ),
+        (
+            Boundary::new().velocity(
+                Range::group("top"),
+                [Some(f64::INFINITY.into()), None, None],
+            ),
+            "mechanical boundary: invalid parameter velocity component 0 = inf",
+        ),
+    ] {
+        let msg = build(mech(), bc);
+        assert!(msg.starts_with(expect), "{msg}");
+        assert!(!msg.contains("mechanics"), "{msg}");
+    }
+    let msg = build(
+        mech().initial_stress(Range::All, [f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        Boundary::new(),
+    );
+    assert!(
+        msg.starts_with("mechanics: invalid parameter initial stress"),
+        "{msg}"
+    );
+}
+
 proptest! {
     #[test]
     fn bulk_shear_and_young_poisson_agree(e in 1e6f64..1e11, nu in 0.0f64..0.49) {
