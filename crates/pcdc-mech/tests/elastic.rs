@@ -558,6 +558,148 @@ fn normal_face_stress_gives_hydrostatic_disc() {
     }
 }
 
+/// Pure shear σ_xy = τ on every face of a square: the static solution is the uniform
+/// engineering shear strain γ = τ / G (u_x = γ y with the rotation fixed by a roller at
+/// the bottom-right corner) and the stress σ_xy = τ in every element. The static
+/// solution keeps the large-rotation kinematics and the tractions follow the faces, so
+/// it departs from the small-strain closed form by O(γ²): about γ / 8 relative here
+/// (γ = 5e-5), well inside the 1e-4 checked.
+#[test]
+fn shear_face_stress_gives_gamma_tau_over_g_2d() {
+    let tau = 2.0e4;
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
+    let corner = |x: f64, y: f64| Range::Ball {
+        center: [x, y, 0.0],
+        radius: 1e-9,
+    };
+    let mut sim = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(
+            Boundary::new()
+                .face_stress(Range::All, FaceStress::shear_xy(tau))
+                .fix(corner(0.0, 0.0))
+                .constraint(corner(1.0, 0.0), Constraint::Line([1.0, 0.0, 0.0])),
+        )
+        .build()
+        .unwrap();
+    sim.solve_linear(&StaticOptions {
+        tolerance: 1e-10,
+        ..Default::default()
+    })
+    .unwrap();
+    let gamma = tau / rock().shear();
+    let x = sim.mesh().coords().to_vec();
+    for (p, u) in x.chunks_exact(2).zip(sim.state.u.chunks_exact(2)) {
+        let expect = [gamma * p[1], 0.0];
+        for k in 0..2 {
+            assert!(
+                (u[k] - expect[k]).abs() < 1e-4 * gamma,
+                "node at {p:?}: u = {u:?}, expected {expect:?} (γ = τ/G = {gamma:e})"
+            );
+        }
+    }
+    for s in output::global_stress(&sim).unwrap().chunks_exact(3) {
+        assert!(
+            s[0].abs() < 1e-4 * tau && s[1].abs() < 1e-4 * tau && (s[2] - tau).abs() < 1e-4 * tau,
+            "{s:?}"
+        );
+    }
+}
+
+/// The three shear components on every face of a cube: γ_ij = τ_ij / G, with u_x =
+/// γ_xy y + γ_xz z, u_y = γ_yz z, u_z = 0 once the rotations are fixed by a roller
+/// along x at (1, 0, 0) and a plane roller at (0, 1, 0).
+#[test]
+fn shear_face_stress_gives_gamma_tau_over_g_3d() {
+    let (txy, tyz, txz) = (2.0e4, -1.0e4, 0.5e4);
+    let mesh = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
+    let corner = |c: [f64; 3]| Range::Ball {
+        center: c,
+        radius: 1e-9,
+    };
+    let mut sim = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(
+            Boundary::new()
+                .face_stress(
+                    Range::All,
+                    FaceStress::tensor([0.0, 0.0, 0.0, txy, tyz, txz]),
+                )
+                .fix(corner([0.0; 3]))
+                .constraint(corner([1.0, 0.0, 0.0]), Constraint::Line([1.0, 0.0, 0.0]))
+                .constraint(corner([0.0, 1.0, 0.0]), Constraint::Plane([0.0, 0.0, 1.0])),
+        )
+        .build()
+        .unwrap();
+    sim.solve_linear(&StaticOptions {
+        tolerance: 1e-10,
+        ..Default::default()
+    })
+    .unwrap();
+    let g = rock().shear();
+    let (gxy, gyz, gxz) = (txy / g, tyz / g, txz / g);
+    let x = sim.mesh().coords().to_vec();
+    for (p, u) in x.chunks_exact(3).zip(sim.state.u.chunks_exact(3)) {
+        let expect = [gxy * p[1] + gxz * p[2], gyz * p[2], 0.0];
+        for k in 0..3 {
+            assert!(
+                (u[k] - expect[k]).abs() < 1e-4 * gxy,
+                "node at {p:?}: u = {u:?}, expected {expect:?}"
+            );
+        }
+    }
+    let expect = [0.0, 0.0, 0.0, txy, tyz, txz];
+    for s in output::global_stress(&sim).unwrap().chunks_exact(6) {
+        for k in 0..6 {
+            assert!((s[k] - expect[k]).abs() < 1e-4 * txy, "{s:?} vs {expect:?}");
+        }
+    }
+}
+
+/// In 2D a shear component out of the plane is an error naming it, not a panic.
+#[test]
+fn out_of_plane_shear_face_stress_is_rejected_in_2d() {
+    for (stress, name) in [
+        (
+            FaceStress {
+                yz: Some(1.0e6.into()),
+                ..Default::default()
+            },
+            "face stress yz",
+        ),
+        (
+            FaceStress {
+                xz: Some(Table::new("t", &[(0.0, 0.0), (1.0, 1.0)]).unwrap().into()),
+                ..Default::default()
+            },
+            "face stress xz",
+        ),
+    ] {
+        let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        let err = Simulation::builder(mesh, cpu(1))
+            .physics(Mechanics::new().material(Range::All, rock()))
+            .physics(Boundary::new().face_stress(Range::group("top"), stress))
+            .build()
+            .err()
+            .expect("an error")
+            .to_string();
+        assert!(
+            err.contains(name) && err.contains("the mesh is 2D"),
+            "{err}"
+        );
+    }
+    // The constant 0 changes nothing and is accepted, as for zz.
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(Boundary::new().face_stress(
+            Range::group("top"),
+            FaceStress::tensor([0.0, -1.0e6, 0.0, 1.0e5, 0.0, 0.0]),
+        ))
+        .build()
+        .unwrap();
+}
+
 #[test]
 fn node_force_acceleration_and_line_constraint() {
     // A free block pushed by node forces accelerates as F/m; a node on a 45° line
