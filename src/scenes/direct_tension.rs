@@ -191,8 +191,8 @@ pub fn run<B: Backend>(backend: &B, p: &Params) -> Result<Outcome, SceneError> {
     })
 }
 
-/// One VTU frame: displacement, global stress and, per element, the largest damage of
-/// its joints.
+/// One VTU frame: the standard arrays of [`output::write_step`] and, per element, the
+/// largest damage of its joints.
 fn write_frame<B: Backend>(
     series: &mut PvdSeries,
     sim: &Simulation<pcdc_mesh::Dim2, B>,
@@ -205,26 +205,14 @@ fn write_frame<B: Backend>(
             elem_damage[e as usize] = f64::max(elem_damage[e as usize], d);
         }
     }
-    let stress = output::global_stress(sim)?;
-    let x = sim.positions();
-    series.write_step(
-        sim.state.time,
-        sim.mesh(),
-        Some(&x),
-        &[DataArray::Vector {
-            name: "displacement",
-            values: &sim.state.u,
+    output::write_step_with(
+        series,
+        sim,
+        &[],
+        &[DataArray::Scalar {
+            name: "joint_damage_max",
+            values: &elem_damage,
         }],
-        &[
-            DataArray::SymTensor {
-                name: "stress",
-                values: &stress,
-            },
-            DataArray::Scalar {
-                name: "joint_damage_max",
-                values: &elem_damage,
-            },
-        ],
     )?;
     Ok(())
 }

@@ -836,8 +836,9 @@ fn broken_joints<B: Backend>(
     Ok((count, cracks))
 }
 
-/// One VTU frame: displacement, velocity (points); stress, σ1, largest joint damage and
-/// number of broken joints per element (cells).
+/// One VTU frame: the standard arrays of [`output::write_step`] (displacement, velocity;
+/// stress, strain, σ1, σ_min) and, per element, the largest joint damage and the number
+/// of broken joints.
 fn write_frame<B: Backend>(
     series: &mut PvdSeries,
     sim: &Simulation<Dim2, B>,
@@ -856,33 +857,11 @@ fn write_frame<B: Backend>(
             }
         }
     }
-    let stress = output::global_stress(sim)?;
-    let principal = output::principal_stress::<Dim2>(&stress);
-    let sigma_1: Vec<f64> = principal.iter().step_by(2).copied().collect();
-    let x = sim.positions();
-    series.write_step(
-        sim.state.time,
-        sim.mesh(),
-        Some(&x),
+    output::write_step_with(
+        series,
+        sim,
+        &[],
         &[
-            DataArray::Vector {
-                name: "displacement",
-                values: &sim.state.u,
-            },
-            DataArray::Vector {
-                name: "velocity",
-                values: &sim.state.v,
-            },
-        ],
-        &[
-            DataArray::SymTensor {
-                name: "stress",
-                values: &stress,
-            },
-            DataArray::Scalar {
-                name: "sigma_1",
-                values: &sigma_1,
-            },
             DataArray::Scalar {
                 name: "joint_damage_max",
                 values: &elem_damage,

@@ -811,6 +811,79 @@ fn initial_stress_is_kept_in_equilibrium() {
     let _ = Dim2::NAME;
 }
 
+/// `write_step_with` writes the standard arrays and the extra point and cell arrays
+/// (names in the right sections, values as given); a name clash is an error and writes
+/// nothing.
+#[test]
+fn write_step_with_adds_point_and_cell_arrays() {
+    use pcdc_mesh::vtu::{DataArray, PvdSeries, VtuEncoding};
+    let dir = std::env::temp_dir().join(format!("pcdc-extra-{}", std::process::id()));
+    let mut sim = loaded_block(1);
+    sim.run(20).unwrap();
+    let (nn, ne) = (sim.mesh().n_nodes(), sim.mesh().n_elements());
+    let node_ids: Vec<f64> = (0..nn).map(|i| i as f64 + 0.5).collect();
+    let elem_flags: Vec<i32> = (0..ne as i32).map(|e| 7 * e).collect();
+    let mut series = PvdSeries::new(&dir, "extra")
+        .unwrap()
+        .with_encoding(VtuEncoding::Ascii);
+    let path = output::write_step_with(
+        &mut series,
+        &sim,
+        &[DataArray::Scalar {
+            name: "node_label",
+            values: &node_ids,
+        }],
+        &[DataArray::Int {
+            name: "elem_flag",
+            values: &elem_flags,
+        }],
+    )
+    .unwrap();
+    let xml = std::fs::read_to_string(&path).unwrap();
+    let at = |name: &str| {
+        xml.find(&format!("Name=\"{name}\""))
+            .unwrap_or_else(|| panic!("no array {name} in {}", path.display()))
+    };
+    let (pd, cd) = (
+        xml.find("<PointData").unwrap(),
+        xml.find("<CellData").unwrap(),
+    );
+    assert!(pd < cd);
+    for name in output::STEP_POINT_ARRAYS.iter().chain(&["node_label"]) {
+        assert!(pd < at(name) && at(name) < cd, "{name} not in PointData");
+    }
+    for name in output::STEP_CELL_ARRAYS.iter().chain(&["elem_flag"]) {
+        assert!(cd < at(name), "{name} not in CellData");
+    }
+    // The values as written: the text of the array up to its closing tag.
+    let values = |name: &str| -> Vec<f64> {
+        let body = &xml[at(name)..];
+        let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
+        body.split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect()
+    };
+    assert_eq!(values("node_label"), node_ids);
+    let flags: Vec<f64> = elem_flags.iter().map(|&f| f as f64).collect();
+    assert_eq!(values("elem_flag"), flags);
+    assert!(xml[at("elem_flag")..].starts_with("Name=\"elem_flag\""));
+    assert!(xml[..at("elem_flag")].ends_with("type=\"Int32\" "));
+    // An extra array named like a standard one is refused; the series is unchanged.
+    let err = output::write_step_with(
+        &mut series,
+        &sim,
+        &[],
+        &[DataArray::Scalar {
+            name: "stress",
+            values: &vec![0.0; ne],
+        }],
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("stress"), "{err}");
+    assert_eq!(series.steps().len(), 1);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 fn history_csv_and_vtu_series() {
     use pcdc_compute::{History, Probe};
