@@ -18,7 +18,7 @@
 //! joint-steps/s = triangle-steps/s x joints/triangles (about 1.5), printed once per mesh.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm};
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams};
 use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
@@ -39,7 +39,18 @@ fn scene_with(cells_x: usize, backend: Backend, contact: bool) -> Simulation<Dim
     let split = split_nodes(&mesh, &Range::All).unwrap();
     let bond_elements = split.joints.elements.clone();
     let bond_faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
-    let czm = IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, 10.0 * E, 10.0 * E, 100.0 * E).unwrap();
+    let czm = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 10e6,
+        tensile_strength: 2e6,
+        gf1: 0.5,
+        gf2: 5.0,
+        penalty_open: 10.0 * E,
+        penalty_shear: 10.0 * E,
+        penalty_overlap: 100.0 * E,
+    }
+    .build()
+    .unwrap();
     let rock = LinearElastic::new(E, 0.25, 2600.0).unwrap();
     let c_p = ((rock.lambda() + 2.0 * rock.shear()) / 2600.0).sqrt();
     let mut b = Simulation::builder(split.mesh, backend)

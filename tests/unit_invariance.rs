@@ -9,7 +9,7 @@
 //! F/λ. Before the friction law was made dimensionally consistent (τ = P_t δ_s / h,
 //! manual eq. 59 corrected), the mm run slid differently from the SI run.
 
-use pcdc::cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE, JOINT_DAMAGE};
+use pcdc::cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE, JOINT_DAMAGE};
 use pcdc::compute::{Backend, Simulation};
 use pcdc::contact::Contact;
 use pcdc::mech::{Boundary, LinearElastic, Mechanics};
@@ -80,16 +80,17 @@ fn run_perturbed(scale: f64, u: Units, steps: u64, eps: f64) -> Outcome {
     let fdem = Range::rect(len(0.079), len(0.0201), len(0.141), len(0.051));
     let split = split_nodes(&mesh, &fdem.clone()).unwrap();
     let rock = LinearElastic::new(e, 0.25, 2600.0 / u.density()).unwrap();
-    let czm = IntrinsicCzm::new(
-        30.0,
-        4e6 / u.stress(),
-        1e6 / u.stress(),
-        1.0 * scale / u.energy_per_area(),
-        5.0 * scale / u.energy_per_area(),
-        10.0 * e,
-        10.0 * e,
-        10.0 * e,
-    )
+    let czm = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 4e6 / u.stress(),
+        tensile_strength: 1e6 / u.stress(),
+        gf1: 1.0 * scale / u.energy_per_area(),
+        gf2: 5.0 * scale / u.energy_per_area(),
+        penalty_open: 10.0 * e,
+        penalty_shear: 10.0 * e,
+        penalty_overlap: 10.0 * e,
+    }
+    .build()
     .unwrap();
     let faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * e)
@@ -229,16 +230,17 @@ fn run_3d(u: Units, steps: u64, eps: f64) -> Outcome {
     let fdem = Range::cuboid([len(0.0199), len(0.0099), len(0.0201)], [len(0.0601); 3]);
     let split = split_nodes(&mesh, &fdem).unwrap();
     let rock = LinearElastic::new(e, 0.25, 2600.0 / u.density()).unwrap();
-    let czm = IntrinsicCzm::new(
-        30.0,
-        4e4 / u.stress(),
-        1e4 / u.stress(),
-        1.0 / u.energy_per_area(),
-        5.0 / u.energy_per_area(),
-        10.0 * e,
-        10.0 * e,
-        10.0 * e,
-    )
+    let czm = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 4e4 / u.stress(),
+        tensile_strength: 1e4 / u.stress(),
+        gf1: 1.0 / u.energy_per_area(),
+        gf2: 5.0 / u.energy_per_area(),
+        penalty_open: 10.0 * e,
+        penalty_shear: 10.0 * e,
+        penalty_overlap: 10.0 * e,
+    }
+    .build()
     .unwrap();
     let faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * e)

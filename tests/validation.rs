@@ -61,7 +61,37 @@ fn vibration_energy_drift_below_half_percent_2d_and_3d() {
 #[test]
 fn direct_tension_peak_at_ts_and_crack_across_the_neck() {
     use pcdc_validation::scenes::direct_tension as dt;
-    let out = dt::run(&cpu(), &dt::Params::reduced()).unwrap();
+    let dir = std::env::temp_dir().join(format!("pcdc-dt-frames-{}", std::process::id()));
+    let p = dt::Params {
+        vtu_dir: Some(dir.clone()),
+        ..dt::Params::reduced()
+    };
+    let out = dt::run(&cpu(), &p).unwrap();
+    // The frames hold the standard arrays of `pcdc_mech::output::write_step` and the
+    // scene's own per-element joint damage (passed to `write_step_with`).
+    let pvd = std::fs::read_to_string(dir.join("direct_tension.pvd")).unwrap();
+    let last = pvd
+        .lines()
+        .filter_map(|l| l.split("file=\"").nth(1))
+        .filter_map(|l| l.split('"').next())
+        .next_back()
+        .expect("a frame");
+    let vtu = std::fs::read(dir.join(last)).unwrap();
+    let head = String::from_utf8_lossy(&vtu[..vtu.len().min(4096)]).into_owned();
+    for name in [
+        "displacement",
+        "velocity",
+        "stress",
+        "strain",
+        "sigma_1",
+        "joint_damage_max",
+    ] {
+        assert!(
+            head.contains(&format!("Name=\"{name}\"")),
+            "{last}: no array {name}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
     eprintln!("direct tension: peak {:.3} MPa ({:+.2} %), elements {}, joints {}, broken {}, steps {}, wall {:.2}s", out.peak / 1e6, 100.0 * out.deviation, out.elements, out.joints, out.broken.len(), out.steps, out.wall_s);
     assert!(
         out.band_metric() <= 1.0,

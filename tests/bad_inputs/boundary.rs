@@ -53,6 +53,18 @@ fn bad_boundary_conditions_are_named_errors() {
             case("face stress zz in 2D", "face stress zz", || {
                 build(b().face_stress(top(), FaceStress::diagonal(0.0, -1e6, -1e6)))
             }),
+            case("face stress yz in 2D", "face stress yz", || {
+                build(b().face_stress(
+                    top(),
+                    FaceStress {
+                        yz: Some(1e6.into()),
+                        ..Default::default()
+                    },
+                ))
+            }),
+            case("NaN face shear", "face stress xy = NaN", || {
+                build(b().face_stress(top(), FaceStress::shear_xy(f64::NAN)))
+            }),
             case("NaN velocity", "velocity component 1 = NaN", || {
                 build(b().velocity(top(), [None, Some(f64::NAN.into()), None]))
             }),

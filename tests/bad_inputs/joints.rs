@@ -1,7 +1,7 @@
 //! Joint models: the intrinsic cohesive zone model and Mohr-Coulomb joints, built and
 //! deserialised.
 
-use pcdc_cohesive::{IntrinsicCzm, MohrCoulombJoint};
+use pcdc_cohesive::{IntrinsicCzm, IntrinsicCzmParams, MohrCoulombJoint, MohrCoulombJointParams};
 
 use crate::{case, run};
 
@@ -12,7 +12,17 @@ fn czm(
     phi: f64,
     p_ov: f64,
 ) -> Result<IntrinsicCzm, pcdc_cohesive::CohesiveError> {
-    IntrinsicCzm::new(phi, c, ts, gf1, 5.0, 3e11, 3e11, p_ov)
+    IntrinsicCzmParams {
+        friction_deg: phi,
+        cohesion: c,
+        tensile_strength: ts,
+        gf1,
+        gf2: 5.0,
+        penalty_open: 3e11,
+        penalty_shear: 3e11,
+        penalty_overlap: p_ov,
+    }
+    .build()
 }
 
 const CZM_JSON: &str = r#"{"friction_deg":30.0,"cohesion":1e7,"tensile_strength":2e6,"gf1":0.5,"gf2":5.0,"penalty_open":3e11,"penalty_shear":3e11,"penalty_overlap":3e12}"#;
@@ -67,17 +77,41 @@ fn bad_joints_are_named_errors() {
             case(
                 "mohr-coulomb: negative friction",
                 "friction angle = -1",
-                || MohrCoulombJoint::new(-1.0, 0.0, 1e10, 1e10),
+                || {
+                    MohrCoulombJointParams {
+                        friction_deg: -1.0,
+                        cohesion: 0.0,
+                        penalty_normal: 1e10,
+                        penalty_shear: 1e10,
+                    }
+                    .build()
+                },
             ),
             case(
                 "mohr-coulomb: negative cohesion",
                 "residual cohesion = -1",
-                || MohrCoulombJoint::new(30.0, -1.0, 1e10, 1e10),
+                || {
+                    MohrCoulombJointParams {
+                        friction_deg: 30.0,
+                        cohesion: -1.0,
+                        penalty_normal: 1e10,
+                        penalty_shear: 1e10,
+                    }
+                    .build()
+                },
             ),
             case(
                 "mohr-coulomb: zero normal penalty",
                 "normal penalty P_n = 0",
-                || MohrCoulombJoint::new(30.0, 0.0, 0.0, 1e10),
+                || {
+                    MohrCoulombJointParams {
+                        friction_deg: 30.0,
+                        cohesion: 0.0,
+                        penalty_normal: 0.0,
+                        penalty_shear: 1e10,
+                    }
+                    .build()
+                },
             ),
             case(
                 "mohr-coulomb toml: NaN shear penalty",

@@ -525,7 +525,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
 #[cfg(test)]
 mod gpu_tests {
     use super::*;
-    use crate::{split_nodes, IntrinsicCzm, MohrCoulombJoint, Traction};
+    use crate::{split_nodes, IntrinsicCzm, IntrinsicCzmParams, MohrCoulombJointParams, Traction};
     use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
     use pcdc_compute::Precision;
     use pcdc_mesh::builders;
@@ -552,7 +552,18 @@ mod gpu_tests {
     }
 
     fn czm() -> IntrinsicCzm {
-        IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, 3e11, 3e11, 3e12).unwrap()
+        IntrinsicCzmParams {
+            friction_deg: 30.0,
+            cohesion: 10e6,
+            tensile_strength: 2e6,
+            gf1: 0.5,
+            gf2: 5.0,
+            penalty_open: 3e11,
+            penalty_shear: 3e11,
+            penalty_overlap: 3e12,
+        }
+        .build()
+        .unwrap()
     }
 
     /// Both built-in models (CZM everywhere, Mohr-Coulomb on one half, a second CZM
@@ -562,10 +573,31 @@ mod gpu_tests {
             point: [0.5, 0.0, 0.0],
             normal: [1.0, 0.0, 0.0],
         };
-        let weak = IntrinsicCzm::new(25.0, 5e6, 1e6, 0.2, 2.0, 3e11, 3e11, 3e12).unwrap();
+        let weak = IntrinsicCzmParams {
+            friction_deg: 25.0,
+            cohesion: 5e6,
+            tensile_strength: 1e6,
+            gf1: 0.2,
+            gf2: 2.0,
+            penalty_open: 3e11,
+            penalty_shear: 3e11,
+            penalty_overlap: 3e12,
+        }
+        .build()
+        .unwrap();
         CohesiveJoints::new(j)
             .model(Range::All, czm())
-            .model(half, MohrCoulombJoint::new(30.0, 0.0, 3e12, 3e11).unwrap())
+            .model(
+                half,
+                MohrCoulombJointParams {
+                    friction_deg: 30.0,
+                    cohesion: 0.0,
+                    penalty_normal: 3e12,
+                    penalty_shear: 3e11,
+                }
+                .build()
+                .unwrap(),
+            )
             .model_for(vec![0, 1], weak)
             .gauss_points_3d(gauss_3d)
     }

@@ -8,9 +8,11 @@
 //! ([`split_nodes`]) that gives the elements of FDEM regions their own nodes and puts a
 //! face-joint on every interior face.
 //!
-//! The joint models ([`IntrinsicCzm`], [`MohrCoulombJoint`]) keep their parameters
-//! private behind accessors; the constructors and deserialisation share one check, so a
-//! model read from a file is validated and its cached derived constants are always built.
+//! The joint models ([`IntrinsicCzm`], [`MohrCoulombJoint`]) are built from parameter
+//! structs with named fields ([`IntrinsicCzmParams`], [`MohrCoulombJointParams`]) and
+//! are immutable afterwards (read accessors only); building and deserialisation share
+//! one check, so a model read from a file is validated and its cached derived constants
+//! are always built from the parameters it holds.
 //!
 //! Joints run on both backends: [`CohesiveJoints`] has a GPU kernel into which each
 //! model's WGSL body ([`JointModel::wgsl`], [`WgslJointModel`]) is spliced; the built-in
@@ -31,7 +33,8 @@ pub use error::CohesiveError;
 pub use fractures::{joints_on_fractures, Distribution, Fracture, FractureNetwork};
 pub use joints::{CohesiveJoints, BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE};
 pub use model::{
-    czm_state, portable_exp, softening, softening_integral, FailureMode, IntrinsicCzm, JointModel,
-    MohrCoulombJoint, Traction, WgslJointModel, SOFTENING_A, SOFTENING_B, SOFTENING_C,
+    czm_state, portable_exp, softening, softening_integral, FailureMode, IntrinsicCzm,
+    IntrinsicCzmParams, JointModel, MohrCoulombJoint, MohrCoulombJointParams, Traction,
+    WgslJointModel, SOFTENING_A, SOFTENING_B, SOFTENING_C,
 };
 pub use split::{split_nodes, Joints, SplitMesh};

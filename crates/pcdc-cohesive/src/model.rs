@@ -253,74 +253,104 @@ pub struct WgslJointModel {
     pub params: Vec<f64>,
 }
 
-/// Parameters of the intrinsic cohesive zone model (manual table 9, keyword
-/// `classic-intrinsic-cohesive-interface`).
+/// The intrinsic cohesive zone model (manual 7.4.1, table 9, keyword
+/// `classic-intrinsic-cohesive-interface`), built from [`IntrinsicCzmParams`].
 ///
-/// The parameters are private (read them with the accessors): [`IntrinsicCzm::new`] and
+/// The model is immutable: [`IntrinsicCzm::new`] (or [`IntrinsicCzmParams::build`]) and
 /// deserialisation share one check (strengths, energies and penalties positive and
-/// finite; 0 ≤ φ < 90°) and build the cached derived constants, which therefore can never
-/// be stale or skipped. The serialised keys are the accessor names.
+/// finite; 0 ≤ φ < 90°) and compute the derived constants (o_p / h, s_p / h, 1 / o_t,
+/// 1 / s_t, tan φ) once; the parameters are read back through accessors only, so the
+/// derived constants can never be stale. To change a parameter, copy
+/// [`IntrinsicCzm::params`], change the field and build again:
+///
+/// ```
+/// # use pcdc_cohesive::{IntrinsicCzm, IntrinsicCzmParams};
+/// let params = IntrinsicCzmParams {
+///     friction_deg: 30.0,
+///     cohesion: 10e6,
+///     tensile_strength: 2e6,
+///     gf1: 0.5,
+///     gf2: 5.0,
+///     penalty_open: 300e9,
+///     penalty_shear: 300e9,
+///     penalty_overlap: 3000e9,
+/// };
+/// let czm = params.build()?;
+/// let weaker = IntrinsicCzmParams { tensile_strength: 1e6, ..czm.params() }.build()?;
+/// assert_eq!(weaker.tensile_strength(), 1e6);
+/// # Ok::<(), pcdc_cohesive::CohesiveError>(())
+/// ```
+///
+/// The serialised form is [`IntrinsicCzmParams`] (the same keys, unknown keys rejected).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "CzmParams", into = "CzmParams")]
+#[serde(try_from = "IntrinsicCzmParams", into = "IntrinsicCzmParams")]
 pub struct IntrinsicCzm {
-    friction_deg: f64,
-    cohesion: f64,
-    tensile_strength: f64,
-    gf1: f64,
-    gf2: f64,
-    penalty_open: f64,
-    penalty_shear: f64,
-    penalty_overlap: f64,
+    params: IntrinsicCzmParams,
     /// ∫₀¹ f(D) dD, cached.
     softening_work: f64,
     /// Constants derived from the parameters, cached so that the per-step path
-    /// evaluates one division and no trigonometry (always set by [`IntrinsicCzm::new`]).
-    derived: Option<Derived>,
+    /// evaluates one division and no trigonometry.
+    derived: Derived,
 }
 
-/// The serialised form of [`IntrinsicCzm`], checked by [`IntrinsicCzm::new`].
-#[derive(Clone, Serialize, Deserialize)]
+/// Parameters of the intrinsic cohesive zone model [`IntrinsicCzm`] (manual 7.4.1,
+/// table 9), by name. SI units; `h` below is a joint's characteristic length (m), the
+/// size of the elements it joins.
+///
+/// [`IntrinsicCzmParams::build`] (or [`IntrinsicCzm::new`]) checks them and builds the
+/// model. Deserialisable (serde) with exactly these keys: unknown keys are rejected.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct CzmParams {
-    friction_deg: f64,
-    cohesion: f64,
-    tensile_strength: f64,
-    gf1: f64,
-    gf2: f64,
-    penalty_open: f64,
-    penalty_shear: f64,
-    penalty_overlap: f64,
+pub struct IntrinsicCzmParams {
+    /// Friction angle φ (degrees, 0 ≤ φ < 90) of the Mohr-Coulomb shear strength
+    /// τ_max = f(D) c − σ tan φ (eq. 64).
+    pub friction_deg: f64,
+    /// Cohesion c (Pa, > 0): the shear strength at zero normal stress (eq. 64); sets the
+    /// peak slip s_p = 2 h c / P_tan (eq. 66).
+    pub cohesion: f64,
+    /// Tensile strength T_s (Pa, > 0): the peak normal traction (eq. 63); sets the peak
+    /// opening o_p = 2 h T_s / P_open (eq. 65) and the overlap length
+    /// o_overlap = 2 h T_s / P_overlap (eq. 67).
+    pub tensile_strength: f64,
+    /// Mode I fracture energy G_f1 (N/m = J/m², > 0): the work of the opening softening
+    /// branch, which sets the softening opening o_t (eq. 70).
+    pub gf1: f64,
+    /// Mode II fracture energy G_f2 (N/m = J/m², > 0): the cohesive work of the sliding
+    /// softening branch, which sets the softening slip s_t (eq. 71).
+    pub gf2: f64,
+    /// Normal opening penalty P_open (Pa, > 0; the manual suggests 10 E): the initial
+    /// normal stiffness P_open / h (eq. 65).
+    pub penalty_open: f64,
+    /// Shear penalty P_tan (Pa, > 0; typically 10 E): the initial shear stiffness
+    /// P_tan / h (eq. 66).
+    pub penalty_shear: f64,
+    /// Overlap penalty P_overlap (Pa, > 0; typically 10-100 E): the stiffness
+    /// P_overlap / h against interpenetration (eq. 63 for o < 0, eq. 67).
+    pub penalty_overlap: f64,
 }
 
-impl TryFrom<CzmParams> for IntrinsicCzm {
-    type Error = CohesiveError;
-
-    fn try_from(p: CzmParams) -> Result<Self, CohesiveError> {
-        IntrinsicCzm::new(
-            p.friction_deg,
-            p.cohesion,
-            p.tensile_strength,
-            p.gf1,
-            p.gf2,
-            p.penalty_open,
-            p.penalty_shear,
-            p.penalty_overlap,
-        )
+impl IntrinsicCzmParams {
+    /// Checks the parameters and builds the model ([`IntrinsicCzm::new`]).
+    ///
+    /// # Errors
+    ///
+    /// [`CohesiveError::InvalidParameter`] naming the first invalid parameter.
+    pub fn build(self) -> Result<IntrinsicCzm, CohesiveError> {
+        IntrinsicCzm::new(self)
     }
 }
 
-impl From<IntrinsicCzm> for CzmParams {
+impl TryFrom<IntrinsicCzmParams> for IntrinsicCzm {
+    type Error = CohesiveError;
+
+    fn try_from(p: IntrinsicCzmParams) -> Result<Self, CohesiveError> {
+        IntrinsicCzm::new(p)
+    }
+}
+
+impl From<IntrinsicCzm> for IntrinsicCzmParams {
     fn from(m: IntrinsicCzm) -> Self {
-        CzmParams {
-            friction_deg: m.friction_deg,
-            cohesion: m.cohesion,
-            tensile_strength: m.tensile_strength,
-            gf1: m.gf1,
-            gf2: m.gf2,
-            penalty_open: m.penalty_open,
-            penalty_shear: m.penalty_shear,
-            penalty_overlap: m.penalty_overlap,
-        }
+        m.params
     }
 }
 
@@ -339,6 +369,21 @@ struct Derived {
     tan_phi: f64,
 }
 
+impl Derived {
+    /// The constants of checked parameters `p`, with `softening_work` = ∫₀¹ f(D) dD
+    /// (the same operations as [`IntrinsicCzm::softening_opening`] and
+    /// [`IntrinsicCzm::softening_slip`]).
+    fn new(p: &IntrinsicCzmParams, softening_work: f64) -> Self {
+        Derived {
+            op_h: 2.0 * p.tensile_strength / p.penalty_open,
+            sp_h: 2.0 * p.cohesion / p.penalty_shear,
+            inv_ot: 1.0 / (p.gf1 / (p.tensile_strength * softening_work)),
+            inv_st: 1.0 / (p.gf2 / (p.cohesion * softening_work)),
+            tan_phi: p.friction_deg.to_radians().tan(),
+        }
+    }
+}
+
 /// State layout of [`IntrinsicCzm`]: damage D, largest opening, largest slip, failure mode.
 pub mod czm_state {
     /// Damage D (eq. 68), never decreasing.
@@ -355,18 +400,22 @@ pub mod czm_state {
 
 impl IntrinsicCzm {
     /// The model with all parameters checked (strengths, energies and penalties
-    /// positive and finite; 0 ≤ φ < 90°).
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        friction_deg: f64,
-        cohesion: f64,
-        tensile_strength: f64,
-        gf1: f64,
-        gf2: f64,
-        penalty_open: f64,
-        penalty_shear: f64,
-        penalty_overlap: f64,
-    ) -> Result<Self, CohesiveError> {
+    /// positive and finite; 0 ≤ φ < 90°) and its derived constants computed.
+    ///
+    /// # Errors
+    ///
+    /// [`CohesiveError::InvalidParameter`] naming the first invalid parameter.
+    pub fn new(params: IntrinsicCzmParams) -> Result<Self, CohesiveError> {
+        let IntrinsicCzmParams {
+            friction_deg,
+            cohesion,
+            tensile_strength,
+            gf1,
+            gf2,
+            penalty_open,
+            penalty_shear,
+            penalty_overlap,
+        } = params;
         let positive: [(&'static str, f64); 7] = [
             ("cohesion c", cohesion),
             ("tensile strength Ts", tensile_strength),
@@ -392,101 +441,86 @@ impl IntrinsicCzm {
                 reason: "must lie in [0, 90) degrees",
             });
         }
+        let softening_work = softening_integral();
+        let derived = Derived::new(&params, softening_work);
         Ok(IntrinsicCzm {
-            friction_deg,
-            cohesion,
-            tensile_strength,
-            gf1,
-            gf2,
-            penalty_open,
-            penalty_shear,
-            penalty_overlap,
-            softening_work: softening_integral(),
-            derived: None,
-        }
-        .with_derived())
+            params,
+            softening_work,
+            derived,
+        })
+    }
+
+    /// The parameters the model was built from (a copy: change a field and build again
+    /// for a different model).
+    pub fn params(&self) -> IntrinsicCzmParams {
+        self.params
     }
 
     /// Friction angle φ (degrees).
     pub fn friction_deg(&self) -> f64 {
-        self.friction_deg
+        self.params.friction_deg
     }
 
     /// Cohesion c (Pa).
     pub fn cohesion(&self) -> f64 {
-        self.cohesion
+        self.params.cohesion
     }
 
     /// Tensile strength T_s (Pa).
     pub fn tensile_strength(&self) -> f64 {
-        self.tensile_strength
+        self.params.tensile_strength
     }
 
     /// Mode I fracture energy G_f1 (N/m).
     pub fn gf1(&self) -> f64 {
-        self.gf1
+        self.params.gf1
     }
 
     /// Mode II fracture energy G_f2 (N/m).
     pub fn gf2(&self) -> f64 {
-        self.gf2
+        self.params.gf2
     }
 
     /// Normal opening penalty P_open (Pa).
     pub fn penalty_open(&self) -> f64 {
-        self.penalty_open
+        self.params.penalty_open
     }
 
     /// Shear penalty P_tan (Pa).
     pub fn penalty_shear(&self) -> f64 {
-        self.penalty_shear
+        self.params.penalty_shear
     }
 
     /// Overlap penalty P_overlap (Pa).
     pub fn penalty_overlap(&self) -> f64 {
-        self.penalty_overlap
-    }
-
-    fn with_derived(mut self) -> Self {
-        self.derived = Some(self.derive());
-        self
-    }
-
-    fn derive(&self) -> Derived {
-        Derived {
-            op_h: 2.0 * self.tensile_strength / self.penalty_open,
-            sp_h: 2.0 * self.cohesion / self.penalty_shear,
-            inv_ot: 1.0 / self.softening_opening(),
-            inv_st: 1.0 / self.softening_slip(),
-            tan_phi: self.friction_deg.to_radians().tan(),
-        }
+        self.params.penalty_overlap
     }
 
     /// Peak opening o_p = 2 h T_s / P_open (eq. 65), m.
     pub fn peak_opening(&self, h: f64) -> f64 {
-        2.0 * h * self.tensile_strength / self.penalty_open
+        2.0 * h * self.params.tensile_strength / self.params.penalty_open
     }
 
     /// Peak slip s_p = 2 h c / P_tan (eq. 66), m.
     pub fn peak_slip(&self, h: f64) -> f64 {
-        2.0 * h * self.cohesion / self.penalty_shear
+        2.0 * h * self.params.cohesion / self.params.penalty_shear
     }
 
     /// Characteristic overlap o_overlap = 2 h T_s / P_overlap (eq. 67), m.
     pub fn overlap_length(&self, h: f64) -> f64 {
-        2.0 * h * self.tensile_strength / self.penalty_overlap
+        2.0 * h * self.params.tensile_strength / self.params.penalty_overlap
     }
 
     /// Softening opening o_t (m): the opening beyond o_p at which D reaches 1, chosen so
     /// that the softening branch dissipates G_f1 (eq. 70): G_f1 = T_s o_t ∫₀¹ f.
     pub fn softening_opening(&self) -> f64 {
-        self.gf1 / (self.tensile_strength * self.softening_work)
+        self.params.gf1 / (self.params.tensile_strength * self.softening_work)
     }
 
     /// Softening slip s_t (m): the cohesive part of the softening branch dissipates
     /// G_f2 (eq. 71, the residual friction work W_res comes on top).
     pub fn softening_slip(&self) -> f64 {
-        self.gf2 / (self.cohesion * self.softening_work)
+        self.params.gf2 / (self.params.cohesion * self.softening_work)
     }
 }
 
@@ -507,7 +541,7 @@ impl JointModel for IntrinsicCzm {
 
     fn traction(&self, o: f64, slip_vec: &[f64], h: f64, state: &mut [f64]) -> Traction {
         use czm_state::*;
-        let dv = self.derived.unwrap_or_else(|| self.derive());
+        let dv = self.derived;
         let inv_h = 1.0 / h;
         let slip = slip_vec.iter().map(|v| v * v).sum::<f64>().sqrt();
         let (op, sp) = (dv.op_h * h, dv.sp_h * h);
@@ -545,9 +579,9 @@ impl JointModel for IntrinsicCzm {
         state[MAX_OPENING] = ou;
         state[MAX_SLIP] = su;
         // Normal traction (eq. 63, unloading eq. 72); 2 T_s / o_overlap = P_overlap / h.
-        let ts = self.tensile_strength;
+        let ts = self.params.tensile_strength;
         let normal = if o < 0.0 {
-            self.penalty_overlap * o * inv_h
+            self.params.penalty_overlap * o * inv_h
         } else if ou > op && o < ou {
             f * ts * o / ou
         } else if o <= op {
@@ -556,7 +590,7 @@ impl JointModel for IntrinsicCzm {
             f * ts
         };
         // Shear strength: Mohr-Coulomb with the softened cohesion (eq. 64).
-        let strength = (-normal * dv.tan_phi + f * self.cohesion).max(0.0);
+        let strength = (-normal * dv.tan_phi + f * self.params.cohesion).max(0.0);
         let shear = if su > sp && slip < su {
             strength * slip / su
         } else if slip <= sp {
@@ -576,9 +610,10 @@ impl JointModel for IntrinsicCzm {
 
     fn max_stiffness(&self, h: f64) -> f64 {
         // Initial slopes: 2 T_s / o_p = P_open / h, 2 T_s / o_overlap = P_overlap / h.
-        self.penalty_open
-            .max(self.penalty_shear)
-            .max(self.penalty_overlap)
+        self.params
+            .penalty_open
+            .max(self.params.penalty_shear)
+            .max(self.params.penalty_overlap)
             / h
     }
 
@@ -592,7 +627,7 @@ impl JointModel for IntrinsicCzm {
 
     /// Parameters: o_p/h, s_p/h, 1/o_t, 1/s_t, tan φ, T_s (Pa), c (Pa), P_overlap (Pa).
     fn wgsl(&self) -> Option<WgslJointModel> {
-        let dv = self.derived.unwrap_or_else(|| self.derive());
+        let dv = self.derived;
         Some(WgslJointModel {
             key: "intrinsic_czm".into(),
             body: include_str!("shaders/intrinsic_czm.wgsl").into(),
@@ -602,9 +637,9 @@ impl JointModel for IntrinsicCzm {
                 dv.inv_ot,
                 dv.inv_st,
                 dv.tan_phi,
-                self.tensile_strength,
-                self.cohesion,
-                self.penalty_overlap,
+                self.params.tensile_strength,
+                self.params.cohesion,
+                self.params.penalty_overlap,
             ],
         })
     }
@@ -617,10 +652,12 @@ impl JointModel for IntrinsicCzm {
 /// holds the plastic slip vector (global components), so reversed sliding unloads
 /// elastically; large rotations of a sliding joint are not followed by that vector.
 ///
-/// The parameters are private (read them with the accessors); [`MohrCoulombJoint::new`]
-/// and deserialisation share one check.
+/// The joint is immutable: [`MohrCoulombJoint::new`] (or
+/// [`MohrCoulombJointParams::build`]) and deserialisation share one check, and the
+/// parameters are read back through accessors; the serialised form is
+/// [`MohrCoulombJointParams`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "MohrCoulombParams", into = "MohrCoulombParams")]
+#[serde(try_from = "MohrCoulombJointParams", into = "MohrCoulombJointParams")]
 pub struct MohrCoulombJoint {
     friction_deg: f64,
     cohesion: f64,
@@ -628,48 +665,63 @@ pub struct MohrCoulombJoint {
     penalty_shear: f64,
 }
 
-/// The serialised form of [`MohrCoulombJoint`], checked by [`MohrCoulombJoint::new`].
-#[derive(Clone, Serialize, Deserialize)]
+/// Parameters of a [`MohrCoulombJoint`] (a pre-existing fracture, manual keyword
+/// `joint-mohr-coulomb`), by name. SI units; `h` is the joint's characteristic length
+/// (m). Deserialisable (serde) with exactly these keys: unknown keys are rejected.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct MohrCoulombParams {
-    friction_deg: f64,
-    cohesion: f64,
-    penalty_normal: f64,
-    penalty_shear: f64,
+pub struct MohrCoulombJointParams {
+    /// Friction angle φ (degrees, 0 ≤ φ < 90) of the shear strength τ_max = c_r − σ tan φ
+    /// (the Mohr-Coulomb criterion of eq. 64 without softening).
+    pub friction_deg: f64,
+    /// Residual cohesion c_r (Pa, ≥ 0, often 0).
+    pub cohesion: f64,
+    /// Normal penalty P_n (Pa, > 0): the stiffness P_n / h against overlap (as the
+    /// overlap branch of eq. 63).
+    pub penalty_normal: f64,
+    /// Shear penalty P_t (Pa, > 0): the elastic shear stiffness P_t / h before sliding.
+    pub penalty_shear: f64,
 }
 
-impl TryFrom<MohrCoulombParams> for MohrCoulombJoint {
-    type Error = CohesiveError;
-
-    fn try_from(p: MohrCoulombParams) -> Result<Self, CohesiveError> {
-        MohrCoulombJoint::new(
-            p.friction_deg,
-            p.cohesion,
-            p.penalty_normal,
-            p.penalty_shear,
-        )
+impl MohrCoulombJointParams {
+    /// Checks the parameters and builds the joint ([`MohrCoulombJoint::new`]).
+    ///
+    /// # Errors
+    ///
+    /// [`CohesiveError::InvalidParameter`] naming the first invalid parameter.
+    pub fn build(self) -> Result<MohrCoulombJoint, CohesiveError> {
+        MohrCoulombJoint::new(self)
     }
 }
 
-impl From<MohrCoulombJoint> for MohrCoulombParams {
+impl TryFrom<MohrCoulombJointParams> for MohrCoulombJoint {
+    type Error = CohesiveError;
+
+    fn try_from(p: MohrCoulombJointParams) -> Result<Self, CohesiveError> {
+        MohrCoulombJoint::new(p)
+    }
+}
+
+impl From<MohrCoulombJoint> for MohrCoulombJointParams {
     fn from(m: MohrCoulombJoint) -> Self {
-        MohrCoulombParams {
-            friction_deg: m.friction_deg,
-            cohesion: m.cohesion,
-            penalty_normal: m.penalty_normal,
-            penalty_shear: m.penalty_shear,
-        }
+        m.params()
     }
 }
 
 impl MohrCoulombJoint {
-    /// The joint with its parameters checked.
-    pub fn new(
-        friction_deg: f64,
-        cohesion: f64,
-        penalty_normal: f64,
-        penalty_shear: f64,
-    ) -> Result<Self, CohesiveError> {
+    /// The joint with its parameters checked (0 ≤ φ < 90°, c_r ≥ 0 and finite,
+    /// penalties positive and finite).
+    ///
+    /// # Errors
+    ///
+    /// [`CohesiveError::InvalidParameter`] naming the first invalid parameter.
+    pub fn new(params: MohrCoulombJointParams) -> Result<Self, CohesiveError> {
+        let MohrCoulombJointParams {
+            friction_deg,
+            cohesion,
+            penalty_normal,
+            penalty_shear,
+        } = params;
         if !(0.0..90.0).contains(&friction_deg) {
             return Err(CohesiveError::InvalidParameter {
                 name: "friction angle",
@@ -702,6 +754,16 @@ impl MohrCoulombJoint {
             penalty_normal,
             penalty_shear,
         })
+    }
+
+    /// The parameters the joint was built from.
+    pub fn params(&self) -> MohrCoulombJointParams {
+        MohrCoulombJointParams {
+            friction_deg: self.friction_deg,
+            cohesion: self.cohesion,
+            penalty_normal: self.penalty_normal,
+            penalty_shear: self.penalty_shear,
+        }
     }
 
     /// Friction angle φ (degrees).
@@ -793,9 +855,20 @@ mod tests {
 
     const H: f64 = 0.002;
 
+    /// UCS quick-start joints (VALIDATION.md scene 8) with E = 30 GPa.
+    const CZM: IntrinsicCzmParams = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 10e6,
+        tensile_strength: 2e6,
+        gf1: 0.5,
+        gf2: 5.0,
+        penalty_open: 300e9,
+        penalty_shear: 300e9,
+        penalty_overlap: 3000e9,
+    };
+
     fn czm() -> IntrinsicCzm {
-        // UCS quick-start joints (scene 8 of docs/validation-scenes.md) with E = 30 GPa.
-        IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, 300e9, 300e9, 3000e9).unwrap()
+        CZM.build().unwrap()
     }
 
     /// Trapezoidal work ∫ σ do along a monotonic path from `a` to `b` in `n` steps.
@@ -861,9 +934,9 @@ mod tests {
         let _ = work_normal(&m, &mut s, 0.0, op, 1000);
         let soft = work_normal(&m, &mut s, op, op + 1.2 * m.softening_opening(), 200_000);
         assert!(
-            (soft - m.gf1).abs() < 0.02 * m.gf1,
+            (soft - m.gf1()).abs() < 0.02 * m.gf1(),
             "softening work {soft} vs Gf1 {}",
-            m.gf1
+            m.gf1()
         );
         assert!(m.is_broken(&s));
         assert_eq!(
@@ -876,7 +949,7 @@ mod tests {
     fn mode_two_dissipates_gf2_plus_friction() {
         let m = czm();
         let sigma_n = -1e6; // compression held by an overlap
-        let o = sigma_n / (2.0 * m.tensile_strength) * m.overlap_length(H);
+        let o = sigma_n / (2.0 * m.tensile_strength()) * m.overlap_length(H);
         let mut s = [0.0; 4];
         let (sp, st) = (m.peak_slip(H), m.softening_slip());
         let n = 200_000;
@@ -889,8 +962,8 @@ mod tests {
         }
         // Residual friction acts until D = 1 at slip s_p + s_t; past the break the joint
         // transfers nothing (contact's friction takes over).
-        let friction = -sigma_n * m.friction_deg.to_radians().tan() * st;
-        let expect = m.gf2 + friction;
+        let friction = -sigma_n * m.friction_deg().to_radians().tan() * st;
+        let expect = m.gf2() + friction;
         assert!(
             (w - expect).abs() < 0.02 * expect,
             "work {w} vs Gf2 + friction {expect}"
@@ -911,8 +984,8 @@ mod tests {
         let above = m
             .traction(op * (1.0 + 1e-9), &[0.0], H, &mut [0.0; 4])
             .normal;
-        assert!((below - m.tensile_strength).abs() < 1e-6 * m.tensile_strength);
-        assert!((above - m.tensile_strength).abs() < 1e-6 * m.tensile_strength);
+        assert!((below - m.tensile_strength()).abs() < 1e-6 * m.tensile_strength());
+        assert!((above - m.tensile_strength()).abs() < 1e-6 * m.tensile_strength());
         let sp = m.peak_slip(H);
         let b = m
             .traction(0.0, &[sp * (1.0 - 1e-9)], H, &mut [0.0; 4])
@@ -920,19 +993,104 @@ mod tests {
         let a = m
             .traction(0.0, &[sp * (1.0 + 1e-9)], H, &mut [0.0; 4])
             .shear_magnitude();
-        assert!((a - b).abs() < 1e-6 * m.cohesion && (a - m.cohesion).abs() < 1e-6 * m.cohesion);
+        assert!(
+            (a - b).abs() < 1e-6 * m.cohesion() && (a - m.cohesion()).abs() < 1e-6 * m.cohesion()
+        );
     }
 
     #[test]
     fn invalid_parameters() {
-        assert!(IntrinsicCzm::new(30.0, 10e6, -2e6, 0.5, 5.0, 3e11, 3e11, 3e12).is_err());
-        assert!(IntrinsicCzm::new(95.0, 10e6, 2e6, 0.5, 5.0, 3e11, 3e11, 3e12).is_err());
-        assert!(IntrinsicCzm::new(30.0, 10e6, 2e6, 0.0, 5.0, 3e11, 3e11, 3e12).is_err());
-        assert!(IntrinsicCzm::new(30.0, 10e6, 2e6, 0.5, 5.0, f64::NAN, 3e11, 3e12).is_err());
+        let bad = |p: IntrinsicCzmParams| p.build().unwrap_err().to_string();
+        assert!(bad(IntrinsicCzmParams {
+            tensile_strength: -2e6,
+            ..CZM
+        })
+        .contains("tensile strength Ts = -2000000"));
+        assert!(bad(IntrinsicCzmParams {
+            friction_deg: 95.0,
+            ..CZM
+        })
+        .contains("friction angle = 95"));
+        assert!(bad(IntrinsicCzmParams { gf1: 0.0, ..CZM }).contains("Gf1 = 0"));
+        assert!(bad(IntrinsicCzmParams {
+            penalty_open: f64::NAN,
+            ..CZM
+        })
+        .contains("P_open = NaN"));
+    }
+
+    /// The stale-cache case: a model rebuilt from its parameters with T_s changed is the
+    /// model built directly with that T_s (derived constants included), and its peak
+    /// traction is the new T_s. (With a mutable T_s, the peak opening cached at `new`
+    /// kept the old T_s: a normal traction of 3.75 MPa where 2.44 MPa was right.)
+    #[test]
+    fn changing_a_parameter_rebuilds_the_derived_constants() {
+        let base = czm();
+        let ts = 1.3e6;
+        let changed = IntrinsicCzmParams {
+            tensile_strength: ts,
+            ..base.params()
+        }
+        .build()
+        .unwrap();
+        let direct = IntrinsicCzmParams {
+            friction_deg: 30.0,
+            cohesion: 10e6,
+            tensile_strength: ts,
+            gf1: 0.5,
+            gf2: 5.0,
+            penalty_open: 300e9,
+            penalty_shear: 300e9,
+            penalty_overlap: 3000e9,
+        }
+        .build()
+        .unwrap();
+        assert_eq!(changed, direct);
+        assert_ne!(changed, base);
+        assert_eq!(changed.params(), direct.params());
+        assert_eq!(changed.wgsl(), direct.wgsl());
+        assert_eq!(changed.tensile_strength(), ts);
+        // Past the new peak opening the joint softens from the new T_s, whatever the
+        // model it was derived from.
+        let o = changed.peak_opening(H);
+        let t = changed.traction(o, &[0.0], H, &mut [0.0; 4]).normal;
+        assert!((t - ts).abs() <= 1e-9 * ts, "peak traction {t} vs T_s {ts}");
+        let t_old = base.traction(o, &[0.0], H, &mut [0.0; 4]).normal;
+        assert!((t_old - t).abs() > 0.1 * ts, "{t_old} vs {t}");
+    }
+
+    /// Serialisation goes through the parameter struct and back through the check.
+    #[test]
+    fn serde_round_trip_and_checked_deserialisation() {
+        let m = czm();
+        let json = serde_json::to_string(&m).unwrap();
+        let back: IntrinsicCzm = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, m);
+        let params: IntrinsicCzmParams = serde_json::from_str(&json).unwrap();
+        assert_eq!(params, CZM);
+        let bad = json.replace("\"gf2\":5.0", "\"gf2\":-5.0");
+        assert_ne!(bad, json);
+        let err = serde_json::from_str::<IntrinsicCzm>(&bad).unwrap_err();
+        assert!(err.to_string().contains("Gf2 = -5"), "{err}");
+
+        let mc = mc();
+        let json = serde_json::to_string(&mc).unwrap();
+        assert_eq!(serde_json::from_str::<MohrCoulombJoint>(&json).unwrap(), mc);
+        assert_eq!(
+            serde_json::from_str::<MohrCoulombJointParams>(&json).unwrap(),
+            mc.params()
+        );
     }
 
     fn mc() -> MohrCoulombJoint {
-        MohrCoulombJoint::new(30.0, 0.0, 3e12, 3e11).unwrap()
+        MohrCoulombJointParams {
+            friction_deg: 30.0,
+            cohesion: 0.0,
+            penalty_normal: 3e12,
+            penalty_shear: 3e11,
+        }
+        .build()
+        .unwrap()
     }
 
     #[test]
@@ -944,7 +1102,7 @@ mod tests {
             Traction::default()
         );
         let o = -1e-9;
-        let sigma = m.penalty_normal * o / H;
+        let sigma = m.penalty_normal() * o / H;
         let t = m.traction(o, &[1e-3, 0.0], H, &mut s);
         let limit = -sigma * 30f64.to_radians().tan();
         assert!((t.normal - sigma).abs() < 1e-9 * sigma.abs());
@@ -955,18 +1113,23 @@ mod tests {
         // Reversing the slip a little unloads elastically.
         let back = m.traction(o, &[1e-3 - 1e-12, 0.0], H, &mut s);
         assert!(back.shear_magnitude() < limit);
-        assert!(MohrCoulombJoint::new(30.0, -1.0, 1.0, 1.0).is_err());
+        assert!(MohrCoulombJointParams {
+            cohesion: -1.0,
+            ..m.params()
+        }
+        .build()
+        .is_err());
     }
 
     proptest! {
         /// Friction never exceeds c_r − σ tan φ, and acts along the slip.
         #[test]
         fn mohr_coulomb_bounded(path in proptest::collection::vec((-2.0f64..0.5, -3.0f64..3.0, -3.0f64..3.0), 1..40)) {
-            let m = MohrCoulombJoint::new(35.0, 1e5, 3e12, 3e11).unwrap();
+            let m = MohrCoulombJointParams { friction_deg: 35.0, cohesion: 1e5, penalty_normal: 3e12, penalty_shear: 3e11 }.build().unwrap();
             let mut s = [0.0; 3];
             for (o, a, b) in path {
                 let t = m.traction(o * 1e-9, &[a * 1e-8, b * 1e-8], H, &mut s);
-                let strength = (m.cohesion - t.normal * 35f64.to_radians().tan()).max(0.0);
+                let strength = (m.cohesion() - t.normal * 35f64.to_radians().tan()).max(0.0);
                 prop_assert!(t.shear_magnitude() <= strength * (1.0 + 1e-12) + 1e-9);
                 prop_assert!(t.normal <= 0.0);
             }
@@ -1016,10 +1179,10 @@ mod tests {
             let at_u = m.traction(ou, &[0.0], H, &mut s).normal;
             let o = back * ou;
             let t = m.traction(o, &[0.0], H, &mut s).normal;
-            prop_assert!((t - at_u * o / ou).abs() <= 1e-9 * m.tensile_strength);
+            prop_assert!((t - at_u * o / ou).abs() <= 1e-9 * m.tensile_strength());
             // Reloading to o_u gives back the same traction (no further damage).
             let again = m.traction(ou, &[0.0], H, &mut s).normal;
-            prop_assert!((again - at_u).abs() <= 1e-9 * m.tensile_strength);
+            prop_assert!((again - at_u).abs() <= 1e-9 * m.tensile_strength());
         }
     }
 }

@@ -23,8 +23,8 @@
 //! skip (and fail with PCDC_REQUIRE_GPU=1).
 
 use pcdc_cohesive::{
-    joints_on_fractures, split_nodes, CohesiveJoints, Fracture, IntrinsicCzm, MohrCoulombJoint,
-    BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE,
+    joints_on_fractures, split_nodes, CohesiveJoints, Fracture, IntrinsicCzmParams,
+    MohrCoulombJointParams, BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE,
 };
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{Backend, Precision, Simulation};
@@ -117,9 +117,30 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
         }),
     );
     // Overlap penalty = opening penalty: the normal traction is smooth at o = 0.
-    let strong =
-        IntrinsicCzm::new(30.0, 8e6, 4e6, 2.0, 20.0, 10.0 * E, 10.0 * E, 10.0 * E).unwrap();
-    let weak = IntrinsicCzm::new(30.0, 2e6, 1e6, 0.01, 0.1, 10.0 * E, 10.0 * E, 10.0 * E).unwrap();
+    let strong = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 8e6,
+        tensile_strength: 4e6,
+        gf1: 2.0,
+        gf2: 20.0,
+        penalty_open: 10.0 * E,
+        penalty_shear: 10.0 * E,
+        penalty_overlap: 10.0 * E,
+    }
+    .build()
+    .unwrap();
+    let weak = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 2e6,
+        tensile_strength: 1e6,
+        gf1: 0.01,
+        gf2: 0.1,
+        penalty_open: 10.0 * E,
+        penalty_shear: 10.0 * E,
+        penalty_overlap: 10.0 * E,
+    }
+    .build()
+    .unwrap();
     let mut joints = CohesiveJoints::new(split.joints.clone())
         .model(Range::All, strong)
         .model(band, weak)
@@ -129,7 +150,14 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
         assert!(!on.is_empty());
         joints = joints.model_for(
             on,
-            MohrCoulombJoint::new(30.0, 0.0, 10.0 * E, 10.0 * E).unwrap(),
+            MohrCoulombJointParams {
+                friction_deg: 30.0,
+                cohesion: 0.0,
+                penalty_normal: 10.0 * E,
+                penalty_shear: 10.0 * E,
+            }
+            .build()
+            .unwrap(),
         );
     }
     let rock = LinearElastic::new(E, 0.25, 2600.0)
@@ -329,8 +357,18 @@ fn joint_forces_agree_to_rounding() {
     };
     fn forces(backend: Backend, amp: f64) -> (Vec<f64>, Vec<f64>) {
         let split = split_nodes(&bar_2d(), &Range::All).unwrap();
-        let czm =
-            IntrinsicCzm::new(30.0, 2e6, 1e6, 0.01, 0.1, 10.0 * E, 10.0 * E, 100.0 * E).unwrap();
+        let czm = IntrinsicCzmParams {
+            friction_deg: 30.0,
+            cohesion: 2e6,
+            tensile_strength: 1e6,
+            gf1: 0.01,
+            gf2: 0.1,
+            penalty_open: 10.0 * E,
+            penalty_shear: 10.0 * E,
+            penalty_overlap: 100.0 * E,
+        }
+        .build()
+        .unwrap();
         let soft = LinearElastic::new(1.0, 0.25, 2600.0).unwrap();
         let mut sim = Simulation::builder(split.mesh, backend)
             .physics(Mechanics::new().material(Range::All, soft))

@@ -1,7 +1,7 @@
 //! A fully split bar pulled apart breaks when its mean stress reaches the tensile
 //! strength (2D and 3D), with results independent of the thread count.
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, JOINT_DAMAGE};
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, IntrinsicCzmParams, JOINT_DAMAGE};
 use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim, Mesh, Range};
@@ -10,7 +10,18 @@ const E: f64 = 30e9;
 const TS: f64 = 2e6;
 
 fn czm() -> IntrinsicCzm {
-    IntrinsicCzm::new(30.0, 10e6, TS, 0.5, 5.0, 10.0 * E, 10.0 * E, 100.0 * E).unwrap()
+    IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 10e6,
+        tensile_strength: TS,
+        gf1: 0.5,
+        gf2: 5.0,
+        penalty_open: 10.0 * E,
+        penalty_shear: 10.0 * E,
+        penalty_overlap: 100.0 * E,
+    }
+    .build()
+    .unwrap()
 }
 
 /// Pulls the `top` group up at `v` with `bottom` held in the pull direction; returns the
@@ -223,7 +234,7 @@ fn joint_forces_identical_for_any_thread_count() {
 
 #[test]
 fn a_pre_existing_fracture_carries_no_tension() {
-    use pcdc_cohesive::{joints_on_fractures, Fracture, MohrCoulombJoint};
+    use pcdc_cohesive::{joints_on_fractures, Fracture, MohrCoulombJointParams};
     let mesh = builders::rectangle(0.0, 0.0, 0.02, 0.04, 0.005).unwrap();
     let split = split_nodes(&mesh, &Range::All).unwrap();
     let on_crack = joints_on_fractures(
@@ -236,7 +247,14 @@ fn a_pre_existing_fracture_carries_no_tension() {
     )
     .unwrap();
     assert_eq!(on_crack.len(), 4);
-    let fracture = MohrCoulombJoint::new(30.0, 0.0, 100.0 * E, 10.0 * E).unwrap();
+    let fracture = MohrCoulombJointParams {
+        friction_deg: 30.0,
+        cohesion: 0.0,
+        penalty_normal: 100.0 * E,
+        penalty_shear: 10.0 * E,
+    }
+    .build()
+    .unwrap();
     let rock = LinearElastic::new(E, 0.25, 2600.0)
         .unwrap()
         .with_damping(0.3)

@@ -18,7 +18,7 @@
 //! the drift that causes (as in the cohesive parity tests).
 //! Without a GPU adapter the tests skip (and fail with PCDC_REQUIRE_GPU=1).
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE};
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_contact::{Contact, CONTACT_REFERENCE};
@@ -80,7 +80,18 @@ fn fdem(backend: Backend, perturb: f64) -> Outcome {
     let mesh = builders::union(&[&a, &b]).unwrap().0;
     let left = Range::rect(-1.0, -1.0, 0.0605, 1.0);
     let split = split_nodes(&mesh, &left).unwrap();
-    let czm = IntrinsicCzm::new(30.0, 4e6, 2e6, 0.01, 0.1, 10.0 * E, 10.0 * E, 10.0 * E).unwrap();
+    let czm = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 4e6,
+        tensile_strength: 2e6,
+        gf1: 0.01,
+        gf2: 0.1,
+        penalty_open: 10.0 * E,
+        penalty_shear: 10.0 * E,
+        penalty_overlap: 10.0 * E,
+    }
+    .build()
+    .unwrap();
     let joints = CohesiveJoints::new(split.joints.clone()).model(Range::All, czm);
     let bond_faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * E)

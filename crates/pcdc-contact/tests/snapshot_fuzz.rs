@@ -11,7 +11,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE};
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
 use pcdc_compute::{Backend, ComputeError, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
@@ -26,7 +26,18 @@ fn fdem(x_struck: f64, friction: f64) -> Simulation<Dim2> {
     let b = builders::rectangle(x_struck, -0.02, 0.04, 0.1, 0.01).unwrap();
     let mesh = builders::union(&[&a, &b]).unwrap().0;
     let split = split_nodes(&mesh, &Range::rect(-1.0, -1.0, 0.0605, 1.0)).unwrap();
-    let czm = IntrinsicCzm::new(30.0, 4e6, 2e6, 0.01, 0.1, 10.0 * E, 10.0 * E, 10.0 * E).unwrap();
+    let czm = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 4e6,
+        tensile_strength: 2e6,
+        gf1: 0.01,
+        gf2: 0.1,
+        penalty_open: 10.0 * E,
+        penalty_shear: 10.0 * E,
+        penalty_overlap: 10.0 * E,
+    }
+    .build()
+    .unwrap();
     let bond_faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * E)
         .friction(friction, 10.0 * E)

@@ -1,11 +1,12 @@
 //! Mechanical boundary conditions (manual 7.2.6, tables 4-7) as one physics:
 //! node velocity and acceleration (constants or tables, per component), node forces,
-//! face stresses (xx, yy, zz and a normal stress that follows the face), and move
-//! constraints (fixed, along a line, in a plane).
+//! face stresses (a stress tensor, xx, yy, zz, xy, yz, xz, and a normal stress that
+//! follows the face), and move constraints (fixed, along a line, in a plane).
 //!
 //! Sign convention: tension positive. A face stress applies the traction `t = σ n` on
-//! the face's current outward normal `n`, with `σ = diag(s_xx, s_yy, s_zz) + s_n I`; a
-//! compressive far-field stress or a pressure is therefore negative.
+//! the face's current outward normal `n`, with σ the symmetric tensor of components
+//! s_xx, s_yy, s_zz, s_xy, s_yz, s_xz plus s_n I; a compressive far-field stress or a
+//! pressure is therefore negative.
 //!
 //! On the GPU backend every item is one kernel (`src/shaders/boundary_*.wgsl`): forces
 //! (node force, face stress) in the force phase, kinematic items (velocity,
@@ -29,6 +30,32 @@ pub const ACCEL_VELOCITY: FieldKey = FieldKey::new(
     Place::Node,
     pcdc_compute::Components::Vector,
 );
+
+/// The physics name of [`Boundary`], which also prefixes its errors.
+const NAME: &str = "mechanical boundary";
+
+/// A boundary error as the simulation reports it: named after the boundary physics
+/// (not "mechanics", the element physics of this crate).
+fn boundary_error(e: MechError) -> ComputeError {
+    e.in_physics(NAME)
+}
+
+/// Checks a prescribed value with [`TimeValue::check`]; its invalid-parameter error
+/// becomes the boundary's own, so that it is named after the boundary physics.
+fn check_value(v: &TimeValue, name: &str) -> Result<(), MechError> {
+    v.check(name).map_err(|e| match e {
+        ComputeError::InvalidParameter {
+            name,
+            value,
+            reason,
+        } => MechError::InvalidParameter {
+            name,
+            value,
+            reason,
+        },
+        other => MechError::Compute(other),
+    })
+}
 
 /// A move constraint (manual table 7).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,15 +96,26 @@ enum Item {
     },
 }
 
-/// A stress applied on boundary faces (manual table 6), Pa, tension positive.
+/// A stress applied on boundary faces (manual table 6), Pa, tension positive: the
+/// traction `t = σ n` on each face's current outward unit normal `n`, σ the symmetric
+/// tensor of the components given (`None` is zero) plus `normal` times the identity.
+///
+/// In 2D, `zz`, `yz` and `xz` must be `None` (or the constant 0): building the simulation
+/// rejects them otherwise, since the plane-strain traction has no z component.
 #[derive(Clone, Debug, Default)]
 pub struct FaceStress {
-    /// σ_xx.
+    /// σ_xx (Pa).
     pub xx: Option<TimeValue>,
-    /// σ_yy.
+    /// σ_yy (Pa).
     pub yy: Option<TimeValue>,
-    /// σ_zz (3D).
+    /// σ_zz (Pa, 3D only).
     pub zz: Option<TimeValue>,
+    /// Shear σ_xy = σ_yx (Pa): traction σ_xy n_y along x and σ_xy n_x along y.
+    pub xy: Option<TimeValue>,
+    /// Shear σ_yz = σ_zy (Pa, 3D only).
+    pub yz: Option<TimeValue>,
+    /// Shear σ_xz = σ_zx (Pa, 3D only).
+    pub xz: Option<TimeValue>,
     /// Normal stress following the face (tension positive; a pressure p is `-p`).
     pub normal: Option<TimeValue>,
 }
@@ -89,6 +127,20 @@ impl FaceStress {
             xx: Some(xx.into()),
             yy: Some(yy.into()),
             zz: Some(zz.into()),
+            ..Default::default()
+        }
+    }
+
+    /// A uniform stress state (constants, Pa) given as `[xx, yy, zz, xy, yz, xz]` (the
+    /// order of [`crate::Sym6`]); in 2D, zz, yz and xz must be 0.
+    pub fn tensor(s: crate::Sym6) -> Self {
+        FaceStress {
+            xx: Some(s[0].into()),
+            yy: Some(s[1].into()),
+            zz: Some(s[2].into()),
+            xy: Some(s[3].into()),
+            yz: Some(s[4].into()),
+            xz: Some(s[5].into()),
             normal: None,
         }
     }
@@ -100,6 +152,31 @@ impl FaceStress {
             ..Default::default()
         }
     }
+
+    /// A pure in-plane shear σ_xy = `tau` (Pa), every other component zero.
+    pub fn shear_xy(tau: impl Into<TimeValue>) -> Self {
+        FaceStress {
+            xy: Some(tau.into()),
+            ..Default::default()
+        }
+    }
+
+    /// The off-diagonal components in the order of the shear signals and of
+    /// [`shear_pair`]: xy, xz, yz.
+    fn shear_components(&self) -> [&Option<TimeValue>; 3] {
+        [&self.xy, &self.xz, &self.yz]
+    }
+
+    /// Whether any shear component is prescribed.
+    fn has_shear(&self) -> bool {
+        self.shear_components().iter().any(|v| v.is_some())
+    }
+}
+
+/// Index in [`FaceStress::shear_components`] of the off-diagonal component σ_cj, c ≠ j:
+/// (0, 1) xy → 0, (0, 2) xz → 1, (1, 2) yz → 2. The WGSL kernel uses the same formula.
+fn shear_pair(c: usize, j: usize) -> usize {
+    c + j - 1
 }
 
 #[derive(Clone, Debug)]
@@ -136,7 +213,7 @@ fn check(values: &Components, what: &str, dim: usize) -> Result<(), MechError> {
                     format!("is prescribed, but the mesh is {dim}D: leave it None"),
                 ));
             }
-            v.check(&format!("{what} component {k}"))?;
+            check_value(v, &format!("{what} component {k}"))?;
         }
     }
     Ok(())
@@ -194,21 +271,28 @@ impl Boundary {
                 Item::Acceleration { values, .. } => check(values, "acceleration", dim)?,
                 Item::NodeForce { values, .. } => check(values, "node force", dim)?,
                 Item::FaceStress { stress, .. } => {
-                    if let (2, Some(zz)) = (dim, stress.zz.as_ref().filter(|v| ignored_in_2d(v))) {
-                        return Err(MechError::param(
-                            "face stress zz",
-                            format!("{zz:?}"),
-                            "is prescribed, but the mesh is 2D: leave it None",
-                        ));
+                    if dim == 2 {
+                        for (n, v) in [("zz", &stress.zz), ("yz", &stress.yz), ("xz", &stress.xz)] {
+                            if let Some(v) = v.as_ref().filter(|v| ignored_in_2d(v)) {
+                                return Err(MechError::param(
+                                    format!("face stress {n}"),
+                                    format!("{v:?}"),
+                                    "is prescribed, but the mesh is 2D: leave it None",
+                                ));
+                            }
+                        }
                     }
                     for (n, v) in [
                         ("xx", &stress.xx),
                         ("yy", &stress.yy),
                         ("zz", &stress.zz),
+                        ("xy", &stress.xy),
+                        ("yz", &stress.yz),
+                        ("xz", &stress.xz),
                         ("normal", &stress.normal),
                     ] {
                         if let Some(v) = v {
-                            v.check(&format!("face stress {n}"))?;
+                            check_value(v, &format!("face stress {n}"))?;
                         }
                     }
                 }
@@ -274,7 +358,7 @@ fn unit<D: Dim>(d: &[f64; 3]) -> [f64; 3] {
 
 impl<D: Dim> Physics<D> for Boundary {
     fn name(&self) -> &str {
-        "mechanical boundary"
+        NAME
     }
 
     /// Face tractions and node forces are applied loads: external work.
@@ -303,7 +387,7 @@ impl<D: Dim> Physics<D> for Boundary {
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
-        self.validate(D::D)?;
+        self.validate(D::D).map_err(boundary_error)?;
         let mesh = ctx.mesh;
         self.resolved.clear();
         self.accel_field = ctx.fields.id(ACCEL_VELOCITY).ok();
@@ -323,12 +407,11 @@ impl<D: Dim> Physics<D> for Boundary {
             if let Item::FaceStress { .. } = it {
                 r.faces = mesh.select_boundary_faces(range).map_err(MechError::from)?;
                 if r.faces.is_empty() {
-                    return Err(MechError::EmptyRange {
+                    return Err(boundary_error(MechError::EmptyRange {
                         what: format!("boundary condition {i} ({what})"),
                         range: format!("{range:?}"),
                         entity: "boundary face",
-                    }
-                    .into());
+                    }));
                 }
                 let nodes: Vec<u32> = r
                     .faces
@@ -339,12 +422,11 @@ impl<D: Dim> Physics<D> for Boundary {
             } else {
                 r.nodes = mesh.select_nodes(range).map_err(MechError::from)?;
                 if r.nodes.is_empty() {
-                    return Err(MechError::EmptyRange {
+                    return Err(boundary_error(MechError::EmptyRange {
                         what: format!("boundary condition {i} ({what})"),
                         range: format!("{range:?}"),
                         entity: "node",
-                    }
-                    .into());
+                    }));
                 }
                 if let Item::NodeForce { .. } = it {
                     r.slots = Some(ctx.register_slots(&r.nodes)?);
@@ -378,6 +460,10 @@ impl<D: Dim> Physics<D> for Boundary {
                         stress.zz.as_ref().map_or(0.0, |v| v.at(t)),
                     ];
                     let sn = stress.normal.as_ref().map_or(0.0, |v| v.at(t));
+                    let has_shear = stress.has_shear();
+                    let shear = stress
+                        .shear_components()
+                        .map(|v| v.as_ref().map_or(0.0, |v| v.at(t)));
                     let npf = D::NODES_PER_FACE;
                     let mut x = [0.0; 9];
                     let mut n = [0.0; 3];
@@ -388,10 +474,23 @@ impl<D: Dim> Physics<D> for Boundary {
                             }
                         }
                         let area = D::face_measure_normal(&x[..npf * d], &mut n[..d]);
+                        // t = σ n: the diagonal term first, then the off-diagonal ones in
+                        // increasing j (the order of the WGSL kernel); without shear the
+                        // traction is exactly (σ_cc + σ_n) n_c.
+                        let mut traction = [0.0; 3];
+                        for c in 0..d {
+                            let mut tc = (diag[c] + sn) * n[c];
+                            if has_shear {
+                                for j in (0..d).filter(|&j| j != c) {
+                                    tc += shear[shear_pair(c, j)] * n[j];
+                                }
+                            }
+                            traction[c] = tc;
+                        }
                         for s in 0..npf {
                             let slot = (block.first + fi * npf + s) * d;
                             for c in 0..d {
-                                ctx.slots[slot + c] = (diag[c] + sn) * n[c] * area / npf as f64;
+                                ctx.slots[slot + c] = traction[c] * area / npf as f64;
                             }
                         }
                     }
@@ -461,9 +560,7 @@ impl<D: Dim> Physics<D> for Boundary {
 
     fn gpu_setup(&mut self, setup: &mut GpuSetup<'_, D>) -> Result<(), ComputeError> {
         if self.resolved.len() != self.items.len() {
-            return Err(ComputeError::Gpu(
-                "mechanical boundary: GPU setup before init".to_string(),
-            ));
+            return Err(ComputeError::Gpu(format!("{NAME}: GPU setup before init")));
         }
         let d = D::D as u32;
         let slot0 = setup.slot_first();
@@ -497,6 +594,26 @@ impl<D: Dim> Physics<D> for Boundary {
                                 + normal.as_ref().map_or(0.0, |v| v.at(t))
                         }
                     });
+                    // Off-diagonal σ_cj (c ≠ j), D (D − 1) / 2 signals after the diagonal
+                    // ones, in the order of `shear_pair`; none without shear (SHEAR = 0
+                    // leaves the kernel's arithmetic that of a diagonal stress).
+                    let has_shear = stress.has_shear();
+                    let mut shear_sig = 0;
+                    if has_shear {
+                        for (p, v) in stress.shear_components()[..D::D * (D::D - 1) / 2]
+                            .iter()
+                            .enumerate()
+                        {
+                            let v = (*v).clone();
+                            let i = setup.signal(move |t: f64, _dt: f64| {
+                                v.as_ref().map_or(0.0, |v| v.at(t))
+                            });
+                            if p == 0 {
+                                shear_sig = i;
+                            }
+                            debug_assert_eq!(i, shear_sig + p as u32);
+                        }
+                    }
                     let face_nodes: Vec<u32> = r
                         .faces
                         .iter()
@@ -510,6 +627,8 @@ impl<D: Dim> Physics<D> for Boundary {
                         .const_real("NPF_REAL", npf as f64)
                         .const_u32("SLOT0", slot0 + block.first as u32)
                         .const_u32("SIG", sig)
+                        .const_u32("SHEAR", u32::from(has_shear))
+                        .const_u32("SHEAR_SIG", shear_sig)
                         .bind("coords", setup.coords(), Access::Read)
                         .bind("disp", setup.displacement(), Access::Read)
                         .bind("faces", faces, Access::Read)
@@ -642,6 +761,9 @@ mod tests {
                     xx: Some(ramp()),
                     yy: Some((-2.0).into()),
                     zz: z(3.0),
+                    xy: Some(ramp()),
+                    yz: z(-1.5),
+                    xz: (dim == 3).then(ramp),
                     normal: Some(ramp()),
                 },
             )

@@ -37,12 +37,25 @@ impl MechError {
     }
 }
 
-impl From<MechError> for pcdc_compute::ComputeError {
-    fn from(e: MechError) -> Self {
-        match e {
+impl MechError {
+    /// This error as a [`pcdc_compute::ComputeError`] raised by the physics named
+    /// `physics`: compute and mesh errors pass through unchanged, the others become
+    /// [`pcdc_compute::ComputeError::Physics`] with their message prefixed by
+    /// `physics` (e.g. "mechanical boundary: invalid parameter ..."), so that the user
+    /// sees which part of the scene is wrong.
+    pub fn in_physics(self, physics: &str) -> pcdc_compute::ComputeError {
+        match self {
             MechError::Compute(c) => c,
             MechError::Mesh(m) => pcdc_compute::ComputeError::Mesh(m),
-            other => pcdc_compute::ComputeError::physics("mechanics", other.to_string()),
+            other => pcdc_compute::ComputeError::physics(physics, other.to_string()),
         }
+    }
+}
+
+/// Errors of [`crate::Mechanics`] (the `?` conversion): named "mechanics". Other
+/// physics of this crate name themselves with [`MechError::in_physics`].
+impl From<MechError> for pcdc_compute::ComputeError {
+    fn from(e: MechError) -> Self {
+        e.in_physics("mechanics")
     }
 }

@@ -80,11 +80,45 @@ pub fn displacement<D: Dim>(sim: &Simulation<D>) -> Result<Vec<f64>, MechError> 
     Ok(sim.state.u.iter().zip(off).map(|(u, o)| u - o).collect())
 }
 
-/// Writes one VTU step with displacement, velocity, global stress, principal stresses and
-/// strain, on the deformed configuration.
+/// Names of the arrays [`write_step`] writes: point data (per node) and cell data (per
+/// element). Extra arrays given to [`write_step_with`] must use other names.
+pub const STEP_POINT_ARRAYS: [&str; 2] = ["displacement", "velocity"];
+/// See [`STEP_POINT_ARRAYS`].
+pub const STEP_CELL_ARRAYS: [&str; 4] = ["stress", "strain", "sigma_1", "sigma_min"];
+
+/// Writes one VTU step on the deformed configuration: per node the displacement since
+/// the last [`crate::reset_displacement`] (m) and the velocity (m/s); per element the
+/// global stress (Pa), the strain, σ1 and the smallest principal stress (Pa). Returns
+/// the path of the `.vtu` file written. Use [`write_step_with`] to add arrays.
 pub fn write_step<D: Dim>(
     series: &mut PvdSeries,
     sim: &Simulation<D>,
+) -> Result<std::path::PathBuf, MechError> {
+    write_step_with(series, sim, &[], &[])
+}
+
+/// [`write_step`] with extra arrays: `points` (one tuple per node) and `cells` (one
+/// tuple per element), written after the standard arrays of the step, e.g. a scene's
+/// largest joint damage per element:
+///
+/// ```ignore
+/// output::write_step_with(&mut series, &sim, &[], &[DataArray::Scalar {
+///     name: "joint_damage_max",
+///     values: &elem_damage,
+/// }])?;
+/// ```
+///
+/// # Errors
+///
+/// [`MechError::Mesh`] (nothing written) when an extra array has the wrong length for
+/// the node or element count, an empty name, or a name already in the step
+/// ([`STEP_POINT_ARRAYS`], [`STEP_CELL_ARRAYS`]) or repeated; as [`write_step`]
+/// otherwise.
+pub fn write_step_with<D: Dim>(
+    series: &mut PvdSeries,
+    sim: &Simulation<D>,
+    points: &[DataArray],
+    cells: &[DataArray],
 ) -> Result<std::path::PathBuf, MechError> {
     let disp = displacement(sim)?;
     let stress = global_stress(sim)?;
@@ -92,41 +126,46 @@ pub fn write_step<D: Dim>(
     let strain = sim.field(names::STRAIN)?;
     let x = sim.positions();
     let np = if D::D == 2 { 2 } else { 3 };
-    let mut cells = vec![
+    let p1: Vec<f64> = principal.iter().step_by(np).copied().collect();
+    let pn: Vec<f64> = principal.iter().skip(np - 1).step_by(np).copied().collect();
+    let [sn, en, p1n, pnn] = STEP_CELL_ARRAYS;
+    let mut cell_data = vec![
         DataArray::SymTensor {
-            name: "stress",
+            name: sn,
             values: &stress,
         },
         DataArray::SymTensor {
-            name: "strain",
+            name: en,
             values: strain,
         },
+        DataArray::Scalar {
+            name: p1n,
+            values: &p1,
+        },
+        DataArray::Scalar {
+            name: pnn,
+            values: &pn,
+        },
     ];
-    let p1: Vec<f64> = principal.iter().step_by(np).copied().collect();
-    let pn: Vec<f64> = principal.iter().skip(np - 1).step_by(np).copied().collect();
-    cells.push(DataArray::Scalar {
-        name: "sigma_1",
-        values: &p1,
-    });
-    cells.push(DataArray::Scalar {
-        name: "sigma_min",
-        values: &pn,
-    });
+    cell_data.extend_from_slice(cells);
+    let [dn, vn] = STEP_POINT_ARRAYS;
+    let mut point_data = vec![
+        DataArray::Vector {
+            name: dn,
+            values: &disp,
+        },
+        DataArray::Vector {
+            name: vn,
+            values: &sim.state.v,
+        },
+    ];
+    point_data.extend_from_slice(points);
     let path = series.write_step(
         sim.state.time,
         sim.mesh(),
         Some(&x),
-        &[
-            DataArray::Vector {
-                name: "displacement",
-                values: &disp,
-            },
-            DataArray::Vector {
-                name: "velocity",
-                values: &sim.state.v,
-            },
-        ],
-        &cells,
+        &point_data,
+        &cell_data,
     )?;
     Ok(path)
 }

@@ -283,6 +283,57 @@ fn invalid_parameters_are_errors() {
     assert!(err.to_string().contains("selects no node"), "{err}");
 }
 
+/// Build errors name the physics they come from: the boundary conditions' errors say
+/// "mechanical boundary" (they used to say "mechanics", pointing the user at the
+/// elements), the elements' errors keep "mechanics".
+#[test]
+fn build_errors_name_their_physics() {
+    let build = |mech: Mechanics, bc: Boundary| {
+        let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        Simulation::builder(mesh, cpu(1))
+            .physics(mech)
+            .physics(bc)
+            .build()
+            .err()
+            .expect("an error")
+            .to_string()
+    };
+    let mech = || Mechanics::new().material(Range::All, rock());
+    for (bc, expect) in [
+        (
+            Boundary::new().fix(Range::rect(5.0, 5.0, 6.0, 6.0)),
+            "mechanical boundary: boundary condition 0 (constraint): the range",
+        ),
+        (
+            Boundary::new().face_stress(Range::group("top"), FaceStress::diagonal(0.0, 1.0, 1.0)),
+            "mechanical boundary: invalid parameter face stress zz",
+        ),
+        (
+            Boundary::new().face_stress(Range::group("top"), FaceStress::normal(f64::NAN)),
+            "mechanical boundary: invalid parameter face stress normal = NaN",
+        ),
+        (
+            Boundary::new().velocity(
+                Range::group("top"),
+                [Some(f64::INFINITY.into()), None, None],
+            ),
+            "mechanical boundary: invalid parameter velocity component 0 = inf",
+        ),
+    ] {
+        let msg = build(mech(), bc);
+        assert!(msg.starts_with(expect), "{msg}");
+        assert!(!msg.contains("mechanics"), "{msg}");
+    }
+    let msg = build(
+        mech().initial_stress(Range::All, [f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        Boundary::new(),
+    );
+    assert!(
+        msg.starts_with("mechanics: invalid parameter initial stress"),
+        "{msg}"
+    );
+}
+
 proptest! {
     #[test]
     fn bulk_shear_and_young_poisson_agree(e in 1e6f64..1e11, nu in 0.0f64..0.49) {
@@ -507,6 +558,148 @@ fn normal_face_stress_gives_hydrostatic_disc() {
     }
 }
 
+/// Pure shear σ_xy = τ on every face of a square: the static solution is the uniform
+/// engineering shear strain γ = τ / G (u_x = γ y with the rotation fixed by a roller at
+/// the bottom-right corner) and the stress σ_xy = τ in every element. The static
+/// solution keeps the large-rotation kinematics and the tractions follow the faces, so
+/// it departs from the small-strain closed form by O(γ²): about γ / 8 relative here
+/// (γ = 5e-5), well inside the 1e-4 checked.
+#[test]
+fn shear_face_stress_gives_gamma_tau_over_g_2d() {
+    let tau = 2.0e4;
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
+    let corner = |x: f64, y: f64| Range::Ball {
+        center: [x, y, 0.0],
+        radius: 1e-9,
+    };
+    let mut sim = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(
+            Boundary::new()
+                .face_stress(Range::All, FaceStress::shear_xy(tau))
+                .fix(corner(0.0, 0.0))
+                .constraint(corner(1.0, 0.0), Constraint::Line([1.0, 0.0, 0.0])),
+        )
+        .build()
+        .unwrap();
+    sim.solve_linear(&StaticOptions {
+        tolerance: 1e-10,
+        ..Default::default()
+    })
+    .unwrap();
+    let gamma = tau / rock().shear();
+    let x = sim.mesh().coords().to_vec();
+    for (p, u) in x.chunks_exact(2).zip(sim.state.u.chunks_exact(2)) {
+        let expect = [gamma * p[1], 0.0];
+        for k in 0..2 {
+            assert!(
+                (u[k] - expect[k]).abs() < 1e-4 * gamma,
+                "node at {p:?}: u = {u:?}, expected {expect:?} (γ = τ/G = {gamma:e})"
+            );
+        }
+    }
+    for s in output::global_stress(&sim).unwrap().chunks_exact(3) {
+        assert!(
+            s[0].abs() < 1e-4 * tau && s[1].abs() < 1e-4 * tau && (s[2] - tau).abs() < 1e-4 * tau,
+            "{s:?}"
+        );
+    }
+}
+
+/// The three shear components on every face of a cube: γ_ij = τ_ij / G, with u_x =
+/// γ_xy y + γ_xz z, u_y = γ_yz z, u_z = 0 once the rotations are fixed by a roller
+/// along x at (1, 0, 0) and a plane roller at (0, 1, 0).
+#[test]
+fn shear_face_stress_gives_gamma_tau_over_g_3d() {
+    let (txy, tyz, txz) = (2.0e4, -1.0e4, 0.5e4);
+    let mesh = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
+    let corner = |c: [f64; 3]| Range::Ball {
+        center: c,
+        radius: 1e-9,
+    };
+    let mut sim = Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(
+            Boundary::new()
+                .face_stress(
+                    Range::All,
+                    FaceStress::tensor([0.0, 0.0, 0.0, txy, tyz, txz]),
+                )
+                .fix(corner([0.0; 3]))
+                .constraint(corner([1.0, 0.0, 0.0]), Constraint::Line([1.0, 0.0, 0.0]))
+                .constraint(corner([0.0, 1.0, 0.0]), Constraint::Plane([0.0, 0.0, 1.0])),
+        )
+        .build()
+        .unwrap();
+    sim.solve_linear(&StaticOptions {
+        tolerance: 1e-10,
+        ..Default::default()
+    })
+    .unwrap();
+    let g = rock().shear();
+    let (gxy, gyz, gxz) = (txy / g, tyz / g, txz / g);
+    let x = sim.mesh().coords().to_vec();
+    for (p, u) in x.chunks_exact(3).zip(sim.state.u.chunks_exact(3)) {
+        let expect = [gxy * p[1] + gxz * p[2], gyz * p[2], 0.0];
+        for k in 0..3 {
+            assert!(
+                (u[k] - expect[k]).abs() < 1e-4 * gxy,
+                "node at {p:?}: u = {u:?}, expected {expect:?}"
+            );
+        }
+    }
+    let expect = [0.0, 0.0, 0.0, txy, tyz, txz];
+    for s in output::global_stress(&sim).unwrap().chunks_exact(6) {
+        for k in 0..6 {
+            assert!((s[k] - expect[k]).abs() < 1e-4 * txy, "{s:?} vs {expect:?}");
+        }
+    }
+}
+
+/// In 2D a shear component out of the plane is an error naming it, not a panic.
+#[test]
+fn out_of_plane_shear_face_stress_is_rejected_in_2d() {
+    for (stress, name) in [
+        (
+            FaceStress {
+                yz: Some(1.0e6.into()),
+                ..Default::default()
+            },
+            "face stress yz",
+        ),
+        (
+            FaceStress {
+                xz: Some(Table::new("t", &[(0.0, 0.0), (1.0, 1.0)]).unwrap().into()),
+                ..Default::default()
+            },
+            "face stress xz",
+        ),
+    ] {
+        let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+        let err = Simulation::builder(mesh, cpu(1))
+            .physics(Mechanics::new().material(Range::All, rock()))
+            .physics(Boundary::new().face_stress(Range::group("top"), stress))
+            .build()
+            .err()
+            .expect("an error")
+            .to_string();
+        assert!(
+            err.contains(name) && err.contains("the mesh is 2D"),
+            "{err}"
+        );
+    }
+    // The constant 0 changes nothing and is accepted, as for zz.
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    Simulation::builder(mesh, cpu(1))
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(Boundary::new().face_stress(
+            Range::group("top"),
+            FaceStress::tensor([0.0, -1.0e6, 0.0, 1.0e5, 0.0, 0.0]),
+        ))
+        .build()
+        .unwrap();
+}
+
 #[test]
 fn node_force_acceleration_and_line_constraint() {
     // A free block pushed by node forces accelerates as F/m; a node on a 45° line
@@ -616,6 +809,79 @@ fn initial_stress_is_kept_in_equilibrium() {
     sim.run(100).unwrap();
     assert!(max_abs(&sim.state.u) < 1e-15, "{}", max_abs(&sim.state.u));
     let _ = Dim2::NAME;
+}
+
+/// `write_step_with` writes the standard arrays and the extra point and cell arrays
+/// (names in the right sections, values as given); a name clash is an error and writes
+/// nothing.
+#[test]
+fn write_step_with_adds_point_and_cell_arrays() {
+    use pcdc_mesh::vtu::{DataArray, PvdSeries, VtuEncoding};
+    let dir = std::env::temp_dir().join(format!("pcdc-extra-{}", std::process::id()));
+    let mut sim = loaded_block(1);
+    sim.run(20).unwrap();
+    let (nn, ne) = (sim.mesh().n_nodes(), sim.mesh().n_elements());
+    let node_ids: Vec<f64> = (0..nn).map(|i| i as f64 + 0.5).collect();
+    let elem_flags: Vec<i32> = (0..ne as i32).map(|e| 7 * e).collect();
+    let mut series = PvdSeries::new(&dir, "extra")
+        .unwrap()
+        .with_encoding(VtuEncoding::Ascii);
+    let path = output::write_step_with(
+        &mut series,
+        &sim,
+        &[DataArray::Scalar {
+            name: "node_label",
+            values: &node_ids,
+        }],
+        &[DataArray::Int {
+            name: "elem_flag",
+            values: &elem_flags,
+        }],
+    )
+    .unwrap();
+    let xml = std::fs::read_to_string(&path).unwrap();
+    let at = |name: &str| {
+        xml.find(&format!("Name=\"{name}\""))
+            .unwrap_or_else(|| panic!("no array {name} in {}", path.display()))
+    };
+    let (pd, cd) = (
+        xml.find("<PointData").unwrap(),
+        xml.find("<CellData").unwrap(),
+    );
+    assert!(pd < cd);
+    for name in output::STEP_POINT_ARRAYS.iter().chain(&["node_label"]) {
+        assert!(pd < at(name) && at(name) < cd, "{name} not in PointData");
+    }
+    for name in output::STEP_CELL_ARRAYS.iter().chain(&["elem_flag"]) {
+        assert!(cd < at(name), "{name} not in CellData");
+    }
+    // The values as written: the text of the array up to its closing tag.
+    let values = |name: &str| -> Vec<f64> {
+        let body = &xml[at(name)..];
+        let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
+        body.split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect()
+    };
+    assert_eq!(values("node_label"), node_ids);
+    let flags: Vec<f64> = elem_flags.iter().map(|&f| f as f64).collect();
+    assert_eq!(values("elem_flag"), flags);
+    assert!(xml[at("elem_flag")..].starts_with("Name=\"elem_flag\""));
+    assert!(xml[..at("elem_flag")].ends_with("type=\"Int32\" "));
+    // An extra array named like a standard one is refused; the series is unchanged.
+    let err = output::write_step_with(
+        &mut series,
+        &sim,
+        &[],
+        &[DataArray::Scalar {
+            name: "stress",
+            values: &vec![0.0; ne],
+        }],
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("stress"), "{err}");
+    assert_eq!(series.steps().len(), 1);
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

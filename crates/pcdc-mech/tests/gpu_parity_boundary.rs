@@ -164,6 +164,7 @@ fn alone_2d(backend: Backend) -> Simulation<Dim2> {
                 yy: Some((-15.0).into()),
                 zz: None,
                 normal: Some(table(&[(0.0, -10.0), (0.01, 25.0)])),
+                ..Default::default()
             },
         )
         .face_stress(Range::group("bottom"), FaceStress::normal(-30.0))
@@ -188,6 +189,7 @@ fn alone_3d(backend: Backend) -> Simulation<Dim3> {
                 yy: Some(table(&[(0.0, 0.0), (0.02, 10.0)])),
                 zz: Some(5.0.into()),
                 normal: Some(table(&[(0.0, 30.0), (0.01, -30.0)])),
+                ..Default::default()
             },
         )
         .face_stress(Range::group("ymin"), FaceStress::normal(-12.0))
@@ -256,6 +258,84 @@ fn boundary_alone_split_runs_2d() {
         c.field(ACCEL_VELOCITY).unwrap(),
     );
     assert!(da <= TOL, "acceleration field differs by {da:e}");
+}
+
+/// Face stresses with shear components in 2D on free point masses: σ_xy from a table
+/// together with diagonal and normal parts on one side, a constant pure shear on
+/// another, a diagonal-only stress (the kernel without shear) on a third.
+fn shear_alone_2d(backend: Backend) -> Simulation<Dim2> {
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.5, 0.125).unwrap();
+    let boundary = Boundary::new()
+        .face_stress(
+            Range::group("right"),
+            FaceStress {
+                xx: Some(table(&[(0.0, 0.0), (0.02, 40.0)])),
+                xy: Some(table(&[(0.0, 10.0), (0.01, -35.0), (0.02, 20.0)])),
+                normal: Some((-5.0).into()),
+                ..Default::default()
+            },
+        )
+        .face_stress(Range::group("top"), FaceStress::shear_xy(25.0))
+        .face_stress(Range::group("left"), FaceStress::diagonal(-10.0, 5.0, 0.0))
+        .fix(Range::rect(-0.01, -0.01, 0.01, 0.01));
+    Simulation::builder(mesh, backend)
+        .physics(PointMass { mass: 0.2 })
+        .physics(boundary)
+        .time_step(1e-4)
+        .build()
+        .unwrap()
+}
+
+/// The three shear components in 3D on free point masses, from tables and constants.
+fn shear_alone_3d(backend: Backend) -> Simulation<Dim3> {
+    let mesh = builders::cuboid([0.0; 3], [1.0, 0.5, 0.5], 0.25).unwrap();
+    let boundary = Boundary::new()
+        .face_stress(
+            Range::group("xmax"),
+            FaceStress {
+                yy: Some((-8.0).into()),
+                xy: Some(table(&[(0.0, 0.0), (0.02, 30.0)])),
+                yz: Some((-12.0).into()),
+                xz: Some(table(&[(0.0, 15.0), (0.01, -15.0)])),
+                ..Default::default()
+            },
+        )
+        .face_stress(
+            Range::group("zmax"),
+            FaceStress::tensor([3.0, 0.0, -6.0, 9.0, -4.0, 7.0]),
+        )
+        .face_stress(Range::group("ymin"), FaceStress::normal(-12.0))
+        .fix(Range::cuboid([-0.01; 3], [0.01; 3]));
+    Simulation::builder(mesh, backend)
+        .physics(PointMass { mass: 0.1 })
+        .physics(boundary)
+        .time_step(1e-4)
+        .build()
+        .unwrap()
+}
+
+#[test]
+fn boundary_alone_shear_face_stress_2d() {
+    let Some(g) = gpu() else { return };
+    compare(
+        "shear face stress 2D",
+        shear_alone_2d(cpu()),
+        shear_alone_2d(g),
+        300,
+        true,
+    );
+}
+
+#[test]
+fn boundary_alone_shear_face_stress_3d() {
+    let Some(g) = gpu() else { return };
+    compare(
+        "shear face stress 3D",
+        shear_alone_3d(cpu()),
+        shear_alone_3d(g),
+        300,
+        true,
+    );
 }
 
 // ---------------------------------------------------------------------------------------
@@ -332,6 +412,7 @@ fn elastic_cuboid(backend: Backend) -> Simulation<Dim3> {
                 yy: None,
                 zz: Some(2.0e5.into()),
                 normal: Some(table(&[(0.0, 0.0), (0.01, -5.0e5)])),
+                ..Default::default()
             },
         )
         .node_force(
@@ -347,6 +428,40 @@ fn elastic_cuboid(backend: Backend) -> Simulation<Dim3> {
         .physics(boundary)
         .build()
         .unwrap()
+}
+
+/// Square under a ramped pure shear σ_xy on every face, one corner fixed, a roller at
+/// the next.
+fn elastic_shear(backend: Backend) -> Simulation<Dim2> {
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.0625).unwrap();
+    let corner = |x: f64| Range::Ball {
+        center: [x, 0.0, 0.0],
+        radius: 1e-9,
+    };
+    let boundary = Boundary::new()
+        .face_stress(
+            Range::All,
+            FaceStress::shear_xy(table(&[(0.0, 0.0), (0.01, 2.0e6)])),
+        )
+        .fix(corner(0.0))
+        .constraint(corner(1.0), Constraint::Line([1.0, 0.0, 0.0]));
+    Simulation::builder(mesh, backend)
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(boundary)
+        .build()
+        .unwrap()
+}
+
+#[test]
+fn elastic_square_pure_shear_2d() {
+    let Some(g) = gpu() else { return };
+    compare(
+        "elastic pure shear",
+        elastic_shear(cpu()),
+        elastic_shear(g),
+        400,
+        false,
+    );
 }
 
 #[test]

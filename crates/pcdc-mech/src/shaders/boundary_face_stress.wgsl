@@ -1,12 +1,16 @@
 // Mechanical boundary: face stress (Pa, tension positive). One invocation per face; the
-// face's NPF slots get the traction share (σ_c + σ_n) n_c A / NPF on the face's current
+// face's NPF slots get the traction share t_c A / NPF, t = σ n on the face's current
 // outward unit normal n and measure A (length in 2D, area in 3D), with the same
 // arithmetic, in the same order, as `Boundary::compute_forces` and
-// `Dim::face_measure_normal`. signal(SIG + c) holds σ_cc + σ_n at the start of the step.
+// `Dim::face_measure_normal`: t_c = (σ_cc + σ_n) n_c, then + σ_cj n_j for j ≠ c in
+// increasing j when SHEAR = 1. signal(SIG + c) holds σ_cc + σ_n at the start of the
+// step; signal(SHEAR_SIG + c + j - 1) holds σ_cj (pairs xy, xz, yz, as `shear_pair`).
 //
 // Constants: D, NPF (nodes per face), NPF_REAL (the same as a Real), SLOT0 (global index
-// of the block's first slot), SIG (first of the D signals). Bindings: coords, disp
-// (read), faces (face node lists, NPF per face, read), slots (read_write).
+// of the block's first slot), SIG (first of the D diagonal signals), SHEAR (1 when
+// shear components are prescribed), SHEAR_SIG (first of the D (D - 1) / 2 shear
+// signals; unused when SHEAR = 0). Bindings: coords, disp (read), faces (face node
+// lists, NPF per face, read), slots (read_write).
 
 // Current position of node n, component c (m).
 fn position(n: u32, c: u32) -> Real {
@@ -23,10 +27,22 @@ fn kernel(f: u32) {
     }
     var n: array<Real, 3>;
     let measure = face_measure_normal(x, &n);
+    var t: array<Real, 3>;
+    for (var c = 0u; c < D; c = c + 1u) {
+        var tc = signal(SIG + c) * n[c];
+        if (SHEAR == 1u) {
+            for (var j = 0u; j < D; j = j + 1u) {
+                if (j != c) {
+                    tc = tc + signal(SHEAR_SIG + c + j - 1u) * n[j];
+                }
+            }
+        }
+        t[c] = tc;
+    }
     for (var s = 0u; s < NPF; s = s + 1u) {
         let base = (SLOT0 + f * NPF + s) * D;
         for (var c = 0u; c < D; c = c + 1u) {
-            slots[base + c] = signal(SIG + c) * n[c] * measure / NPF_REAL;
+            slots[base + c] = t[c] * measure / NPF_REAL;
         }
     }
 }

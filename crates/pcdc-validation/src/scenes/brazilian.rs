@@ -382,7 +382,7 @@ pub fn report(
     }
     if let Some(pvd) = &out.pvd {
         println!(
-            "VTU series (ParaView; cells: joint_damage_max, broken_joints, stress): {}",
+            "VTU series (ParaView; cells: joint_damage_max, broken_joints, stress, strain, sigma_1, sigma_min): {}",
             pvd.display()
         );
     }

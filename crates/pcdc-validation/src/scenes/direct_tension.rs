@@ -15,7 +15,7 @@
 
 use std::time::Instant;
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, JOINT_DAMAGE};
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, JOINT_DAMAGE};
 use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{output, Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::vtu::{DataArray, PvdSeries};
@@ -102,7 +102,17 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     let start = Instant::now();
     let mesh = builders::dog_bone(0.05, 0.15, 0.15, NECK, p.size)?;
     let split = split_nodes(&mesh, &Range::All)?;
-    let czm = IntrinsicCzm::new(45.0, 25e6, TS, 1e-4, 0.2, 10.0 * E, 10.0 * E, 100.0 * E)?;
+    let czm = IntrinsicCzmParams {
+        friction_deg: 45.0,
+        cohesion: 25e6,
+        tensile_strength: TS,
+        gf1: 1e-4,
+        gf2: 0.2,
+        penalty_open: 10.0 * E,
+        penalty_shear: 10.0 * E,
+        penalty_overlap: 100.0 * E,
+    }
+    .build()?;
     let rock = LinearElastic::new(E, 0.25, 2600.0)?.with_damping(0.5)?;
     let joints = split.joints.clone();
     let up = pcdc_compute::Table::new("edge velocity", &[(0.0, 0.0), (RAMP, V)])?;
@@ -181,8 +191,8 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     })
 }
 
-/// One VTU frame: displacement, global stress and, per element, the largest damage of
-/// its joints.
+/// One VTU frame: the standard arrays of [`output::write_step`] and, per element, the
+/// largest damage of its joints.
 fn write_frame(
     series: &mut PvdSeries,
     sim: &Simulation<pcdc_mesh::Dim2>,
@@ -195,26 +205,14 @@ fn write_frame(
             elem_damage[e as usize] = f64::max(elem_damage[e as usize], d);
         }
     }
-    let stress = output::global_stress(sim)?;
-    let x = sim.positions();
-    series.write_step(
-        sim.state.time,
-        sim.mesh(),
-        Some(&x),
-        &[DataArray::Vector {
-            name: "displacement",
-            values: &sim.state.u,
+    output::write_step_with(
+        series,
+        sim,
+        &[],
+        &[DataArray::Scalar {
+            name: "joint_damage_max",
+            values: &elem_damage,
         }],
-        &[
-            DataArray::SymTensor {
-                name: "stress",
-                values: &stress,
-            },
-            DataArray::Scalar {
-                name: "joint_damage_max",
-                values: &elem_damage,
-            },
-        ],
     )?;
     Ok(())
 }

@@ -23,7 +23,7 @@
 
 use std::time::Instant;
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, BROKEN_FACE};
+use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
 use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
@@ -128,7 +128,17 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     wall_nodes.dedup();
     mesh.add_node_group("walls", wall_nodes.clone())?;
     let rock = LinearElastic::new(E, 0.25, 2600.0)?;
-    let czm = IntrinsicCzm::new(30.0, 4e6, 1e6, 1.0, 5.0, 10.0 * E, 10.0 * E, 10.0 * E)?;
+    let czm = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 4e6,
+        tensile_strength: 1e6,
+        gf1: 1.0,
+        gf2: 5.0,
+        penalty_open: 10.0 * E,
+        penalty_shear: 10.0 * E,
+        penalty_overlap: 10.0 * E,
+    }
+    .build()?;
     let bond_faces: Vec<u32> = joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * E)
         .friction(30.0, 10.0 * E)

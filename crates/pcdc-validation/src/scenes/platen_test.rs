@@ -14,8 +14,8 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use pcdc_cohesive::{
-    czm_state, split_nodes, CohesiveJoints, FailureMode, IntrinsicCzm, BROKEN_FACE, JOINT_DAMAGE,
-    JOINT_STATE,
+    czm_state, split_nodes, CohesiveJoints, FailureMode, IntrinsicCzm, IntrinsicCzmParams,
+    BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE,
 };
 use pcdc_compute::{Backend, BackendKind, Simulation, Table, TimeValue};
 use pcdc_contact::Contact;
@@ -289,16 +289,17 @@ impl JointParams {
 
     /// The intrinsic CZM for a rock of Young's modulus `young` (Pa).
     pub fn model(&self, young: f64) -> Result<IntrinsicCzm, SceneError> {
-        Ok(IntrinsicCzm::new(
-            self.friction_deg,
-            self.cohesion,
-            self.tensile_strength,
-            self.gf1,
-            self.gf2,
-            self.penalty_normal * young,
-            self.penalty_shear * young,
-            self.penalty_overlap * young,
-        )?)
+        Ok(IntrinsicCzmParams {
+            friction_deg: self.friction_deg,
+            cohesion: self.cohesion,
+            tensile_strength: self.tensile_strength,
+            gf1: self.gf1,
+            gf2: self.gf2,
+            penalty_open: self.penalty_normal * young,
+            penalty_shear: self.penalty_shear * young,
+            penalty_overlap: self.penalty_overlap * young,
+        }
+        .build()?)
     }
 }
 
@@ -835,8 +836,9 @@ fn broken_joints(
     Ok((count, cracks))
 }
 
-/// One VTU frame: displacement, velocity (points); stress, σ1, largest joint damage and
-/// number of broken joints per element (cells).
+/// One VTU frame: the standard arrays of [`output::write_step`] (displacement, velocity;
+/// stress, strain, σ1, σ_min) and, per element, the largest joint damage and the number
+/// of broken joints.
 fn write_frame(
     series: &mut PvdSeries,
     sim: &Simulation<Dim2>,
@@ -855,33 +857,11 @@ fn write_frame(
             }
         }
     }
-    let stress = output::global_stress(sim)?;
-    let principal = output::principal_stress::<Dim2>(&stress);
-    let sigma_1: Vec<f64> = principal.iter().step_by(2).copied().collect();
-    let x = sim.positions();
-    series.write_step(
-        sim.state.time,
-        sim.mesh(),
-        Some(&x),
+    output::write_step_with(
+        series,
+        sim,
+        &[],
         &[
-            DataArray::Vector {
-                name: "displacement",
-                values: &sim.state.u,
-            },
-            DataArray::Vector {
-                name: "velocity",
-                values: &sim.state.v,
-            },
-        ],
-        &[
-            DataArray::SymTensor {
-                name: "stress",
-                values: &stress,
-            },
-            DataArray::Scalar {
-                name: "sigma_1",
-                values: &sigma_1,
-            },
             DataArray::Scalar {
                 name: "joint_damage_max",
                 values: &elem_damage,

@@ -817,7 +817,7 @@ pub fn report(
     }
     if let Some(pvd) = &out.pvd {
         println!(
-            "VTU series (ParaView; cells: joint_damage_max, broken_joints, stress, sigma_1): {}",
+            "VTU series (ParaView; cells: joint_damage_max, broken_joints, stress, strain, sigma_1, sigma_min): {}",
             pvd.display()
         );
     }
