@@ -2,21 +2,46 @@
 //! skin, the GPU candidate capacity and bonded pairs; each is an error naming the
 //! parameter when the simulation is built.
 
-use pcdc_compute::{Backend, Simulation};
+use pcdc_compute::{
+    Backend, Components, ComputeError, FieldKey, FieldUse, ForceContext, InitContext, Physics,
+    Place, Simulation,
+};
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Range};
+use pcdc_mesh::{builders, Dim2, Mesh, Range};
 
 use crate::{case, run};
 
 const E: f64 = 30e9;
 
+/// Owns a face flag field named `broken_face` (what the cohesive joints own in FDEM
+/// regions), so that bonded pairs have a field to read.
+struct FaceFlags;
+
+const FLAGS: FieldKey = FieldKey::new("broken_face", Place::Face, Components::Fixed(1));
+
+impl Physics<Dim2> for FaceFlags {
+    fn name(&self) -> &str {
+        "face flags"
+    }
+    fn fields(&self, _mesh: &Mesh<Dim2>) -> Vec<FieldUse> {
+        vec![FLAGS.own::<Dim2>()]
+    }
+    fn init(&mut self, _ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
+        Ok(())
+    }
+    fn compute_forces(&mut self, _ctx: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
+        Ok(())
+    }
+}
+
 /// Builds two elastic triangles' worth of mesh with `contact`.
-fn build(contact: Contact) -> Result<(), pcdc_compute::ComputeError> {
+fn build(contact: Contact) -> Result<(), ComputeError> {
     let mesh = builders::rectangle(0.0, 0.0, 0.1, 0.05, 0.05).unwrap();
     let rock = LinearElastic::new(E, 0.25, 2600.0).unwrap();
     Simulation::builder(mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
+        .physics(FaceFlags)
         .physics(contact)
         .build()
         .map(|_| ())
@@ -102,8 +127,8 @@ fn bad_contact_is_a_named_error() {
                 build(Contact::new(E).bonded_pairs(&[0, 1], &[9999], "broken_face"))
             }),
             case(
-                "broken-bond field nobody declares",
-                "no field named 'no_such_field'",
+                "broken-bond field nobody owns",
+                "reads field 'no_such_field', but no composed physics owns it",
                 || build(Contact::new(E).bonded_pairs(&[0, 1], &[0], "no_such_field")),
             ),
         ],

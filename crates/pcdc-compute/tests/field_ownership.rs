@@ -49,7 +49,8 @@ impl Physics<Dim2> for Probe {
 
 fn build(physics: Vec<Probe>) -> Result<Simulation<Dim2>, ComputeError> {
     let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
-    let mut b = Simulation::builder(mesh, Backend::cpu(1).unwrap());
+    // No physics here limits the step: give one.
+    let mut b = Simulation::builder(mesh, Backend::cpu(1).unwrap()).time_step(1e-3);
     for p in physics {
         b = b.physics(p);
     }

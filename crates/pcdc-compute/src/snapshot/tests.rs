@@ -21,6 +21,8 @@ struct Springs {
     rho: f64,
     hook: bool,
     counter: u64,
+    /// Whether this instance owns the energy field (a second instance writes it).
+    owner: bool,
 }
 
 impl Springs {
@@ -30,6 +32,7 @@ impl Springs {
             rho,
             hook: true,
             counter: 0,
+            owner: true,
         }
     }
 }
@@ -39,7 +42,11 @@ impl Physics<Dim2> for Springs {
         "springs"
     }
     fn fields(&self, _mesh: &Mesh<Dim2>) -> Vec<FieldUse> {
-        vec![SPRING_ENERGY.own::<Dim2>()]
+        if self.owner {
+            vec![SPRING_ENERGY.own::<Dim2>()]
+        } else {
+            vec![SPRING_ENERGY.write::<Dim2>()]
+        }
     }
     fn init(&mut self, ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
         let nodes: Vec<u32> = (0..ctx.mesh.n_nodes() as u32).collect();
@@ -262,7 +269,10 @@ fn foreign_scenes_are_refused_by_name() {
     // Another composition.
     let mut e2 = Simulation::builder(mesh, cpu())
         .physics(Springs::new(1e3, 1.0))
-        .physics(Springs::new(1e3, 1.0))
+        .physics(Springs {
+            owner: false,
+            ..Springs::new(1e3, 1.0)
+        })
         .build()
         .unwrap();
     let e = e2.restore_bytes(&snap).unwrap_err().to_string();
@@ -381,6 +391,7 @@ fn physics_states_restore_all_or_nothing() {
         let (mut s0, mut s1) = (Springs::new(1e3, 1.0), Springs::new(1e3, 1.0));
         s0.counter = c0;
         s1.counter = c1;
+        s1.owner = false;
         Simulation::builder(mesh.clone(), cpu())
             .physics(s0)
             .physics(s1)
