@@ -30,6 +30,7 @@ use pcdc_compute::{
     ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
     StableStep,
 };
+use pcdc_compute::{Entity, EntityKind};
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
@@ -391,7 +392,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         }
         best.map(|(dt, j)| StableStep {
             dt,
-            entity: format!("joint {j}"),
+            entity: Entity::new(EntityKind::Joint, j),
             physics: "cohesive joints".into(),
         })
     }

@@ -219,7 +219,11 @@ fn undamped_joints_limit_the_time_step() {
         .build()
         .unwrap();
     let limit = sim.time_step_limit().unwrap();
-    assert!(limit.entity.starts_with("joint "), "{limit:?}");
+    assert_eq!(
+        limit.entity.kind,
+        pcdc_compute::EntityKind::Joint,
+        "{limit:?}"
+    );
     assert_eq!(limit.physics, "cohesive joints");
 }
 

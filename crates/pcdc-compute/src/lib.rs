@@ -32,6 +32,7 @@ mod history;
 mod physics;
 mod simulation;
 pub mod snapshot;
+mod stages;
 mod statics;
 mod table;
 
@@ -47,9 +48,10 @@ pub use fingerprint::Fingerprint;
 pub use gpu::WgpuBackend;
 pub use history::{History, Probe};
 pub use physics::{
-    DofConstraint, ForceContext, InitContext, Kinematics, Physics, SlotBlock, StableStep,
-    VelocityContext,
+    DofConstraint, Entity, EntityKind, FieldContext, FieldSchedule, ForceContext, InitContext,
+    Kinematics, Physics, SlotBlock, StableStep, SubCycle, VelocityContext,
 };
 pub use simulation::{Simulation, SimulationBuilder, State, DEFAULT_SAFETY};
+pub use stages::{FieldStage, MAX_SUBCYCLE};
 pub use statics::{StaticOptions, StaticReport};
 pub use table::{Table, TimeValue};

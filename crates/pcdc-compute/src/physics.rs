@@ -19,15 +19,128 @@ pub struct SlotBlock {
     pub len: usize,
 }
 
-/// What limits the stable time step.
+/// Kinds of entities a physics reports (in stable steps and errors).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EntityKind {
+    /// A mesh node.
+    Node,
+    /// A mesh element.
+    Element,
+    /// A mesh face.
+    Face,
+    /// A face-joint (cohesive interface).
+    Joint,
+    /// An entity of a physics-defined set, named by its kind (e.g. "contact element",
+    /// "bolt segment", "flow channel").
+    Other(&'static str),
+}
+
+/// A typed entity: kind and index, e.g. element 42. Displays as `element 42`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Entity {
+    /// What the index counts.
+    pub kind: EntityKind,
+    /// Index within its kind.
+    pub index: usize,
+}
+
+impl Entity {
+    /// An entity.
+    pub fn new(kind: EntityKind, index: usize) -> Self {
+        Entity { kind, index }
+    }
+}
+
+impl std::fmt::Display for Entity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let kind = match self.kind {
+            EntityKind::Node => "node",
+            EntityKind::Element => "element",
+            EntityKind::Face => "face",
+            EntityKind::Joint => "joint",
+            EntityKind::Other(k) => k,
+        };
+        write!(f, "{kind} {}", self.index)
+    }
+}
+
+/// What limits a stable time step: the mechanical step ([`Physics::stable_step`]) or a
+/// physics' own sub-cycled field step ([`Physics::field_stable_step`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct StableStep {
     /// Critical time step of the limiting entity (s), before the safety factor.
     pub dt: f64,
-    /// The limiting entity, e.g. "element 42".
-    pub entity: String,
+    /// The limiting entity.
+    pub entity: Entity,
     /// Which physics reported it.
     pub physics: String,
+}
+
+/// How a physics' field stage runs relative to the mechanical step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SubCycle {
+    /// `n` field steps of `dt / n` after every mechanical step (a field whose stable
+    /// step is smaller than the mechanical one).
+    Substeps(u32),
+    /// One field step of `n dt` after every `n`-th mechanical step (a field whose stable
+    /// step is larger, e.g. slow diffusion).
+    Every(u32),
+}
+
+impl SubCycle {
+    /// Field steps per mechanical step (`Substeps(n)`: n) or 1.
+    pub fn substeps(self) -> u32 {
+        match self {
+            SubCycle::Substeps(n) => n,
+            SubCycle::Every(_) => 1,
+        }
+    }
+
+    /// The field step over the mechanical step: `1/n` or `n`. The field step is
+    /// `dt * scale()` on both backends (GPU kernels: `p_dt() * FIELD_DT_SCALE`).
+    pub fn scale(self) -> f64 {
+        match self {
+            SubCycle::Substeps(n) => 1.0 / n as f64,
+            SubCycle::Every(n) => n as f64,
+        }
+    }
+
+    /// Whether the field stage runs after mechanical step number `step` (1-based).
+    pub fn runs_after(self, step: u64) -> bool {
+        match self {
+            SubCycle::Substeps(_) => true,
+            SubCycle::Every(n) => step % n.max(1) as u64 == 0,
+        }
+    }
+}
+
+/// How a physics asks its field stage to be scheduled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FieldSchedule {
+    /// From [`Physics::field_stable_step`] (times the safety factor) and the mechanical
+    /// step: sub-steps when the field is the faster, one step every n mechanical steps
+    /// when it is the slower.
+    Auto,
+    /// A fixed ratio.
+    Fixed(SubCycle),
+}
+
+/// Context of the post-update and field stages (after the position update).
+pub struct FieldContext<'a, D: Dim> {
+    /// Kinematic state at the end of the mechanical step (`u` updated, `v` at the half
+    /// step); `kin.dt` is the mechanical step.
+    pub kin: Kinematics<'a, D>,
+    /// Field storage.
+    pub fields: &'a mut FieldStore,
+    /// The step of this stage (s): the mechanical step in the post-update stage, the
+    /// field step (`dt * SubCycle::scale`) in a field stage.
+    pub dt: f64,
+    /// Time at the start of this field step (s).
+    pub time: f64,
+    /// Index of this sub-step within the mechanical step (0 without sub-steps).
+    pub substep: u32,
+    /// The backend.
+    pub backend: &'a Backend,
 }
 
 /// Read-only view of the kinematic state during a step.
@@ -175,8 +288,40 @@ pub trait Physics<D: Dim>: Send + Sync {
         None
     }
 
-    /// Computes this physics' forces into its slots (and updates its fields).
+    /// Forces stage: computes this physics' forces into its slots (and updates its
+    /// fields).
     fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError>;
+
+    /// Post-update stage: runs once after every mechanical step's position update, in
+    /// composition order (e.g. fields derived from the new positions). Default: nothing.
+    /// GPU kernels of this stage use [`crate::gpu::Phase::PostUpdate`].
+    fn post_update(&mut self, _ctx: &mut FieldContext<'_, D>) -> Result<(), ComputeError> {
+        Ok(())
+    }
+
+    /// Whether this physics has a sub-cycled field stage, and how it is scheduled
+    /// (fixed when the simulation is built). Default: none.
+    fn field_schedule(&self) -> Option<FieldSchedule> {
+        None
+    }
+
+    /// The critical step of this physics' own field stage (s), before the safety factor,
+    /// with its limiting entity; used by [`FieldSchedule::Auto`]. It does not limit the
+    /// mechanical step.
+    fn field_stable_step(
+        &self,
+        _kin: &Kinematics<'_, D>,
+        _fields: &FieldStore,
+    ) -> Option<StableStep> {
+        None
+    }
+
+    /// One field step of the sub-cycled field stage (after the post-update stage; as
+    /// often as [`SubCycle`] says). GPU kernels of this stage use
+    /// [`crate::gpu::Phase::Field`] and are repeated the same number of times.
+    fn field_step(&mut self, _ctx: &mut FieldContext<'_, D>) -> Result<(), ComputeError> {
+        Ok(())
+    }
 
     /// Imposes prescribed velocities, accelerations and constraints on the freshly
     /// integrated velocities.

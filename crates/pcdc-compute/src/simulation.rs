@@ -242,6 +242,7 @@ impl<D: Dim> SimulationBuilder<D> {
             damping: true,
             local_damping,
             energy: None,
+            field_stages: Vec::new(),
         };
         if let Some(tol) = energy {
             let loads: Vec<bool> = sim.physics.iter().map(|p| p.applies_loads()).collect();
@@ -252,6 +253,7 @@ impl<D: Dim> SimulationBuilder<D> {
             )));
         }
         sim.update_time_step()?;
+        sim.schedule_field_stages()?;
         #[cfg(feature = "gpu")]
         if let Some(gpu) = sim.backend.as_gpu().cloned() {
             sim.gpu = Some(Box::new(GpuRun::new(&gpu, &mut sim, &layout)?));
@@ -429,6 +431,8 @@ pub struct Simulation<D: Dim> {
     pub(crate) device_fresh: bool,
     /// Energy balance accumulators, when tracking is on.
     pub(crate) energy: Option<Box<EnergyTracker>>,
+    /// Schedule of each physics' field stage (`None`: it has none), fixed at build.
+    pub(crate) field_stages: Vec<Option<crate::FieldStage>>,
 }
 
 impl<D: Dim> Simulation<D> {
@@ -447,6 +451,7 @@ impl<D: Dim> Simulation<D> {
         self.energy_before_update();
         self.gather(true);
         self.finish_step()?;
+        self.after_update()?;
         self.energy_after_step()
     }
 

@@ -42,6 +42,7 @@ use pcdc_compute::{
     ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
     StableStep,
 };
+use pcdc_compute::{Entity, EntityKind};
 use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;
 
@@ -431,7 +432,7 @@ impl Contact {
         }
         StableStep {
             dt: best,
-            entity: format!("contact at node {which}"),
+            entity: Entity::new(EntityKind::Other("contact at node"), which),
             physics: "contact".into(),
         }
     }
@@ -878,7 +879,7 @@ impl<D: Dim> Physics<D> for Contact {
         }
         Some(StableStep {
             dt: best,
-            entity: format!("contact at node {which}"),
+            entity: Entity::new(EntityKind::Other("contact at node"), which),
             physics: "contact".into(),
         })
     }

@@ -16,6 +16,7 @@ use pcdc_compute::{
     names, ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics,
     Physics, StableStep,
 };
+use pcdc_compute::{Entity, EntityKind};
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
@@ -615,7 +616,7 @@ impl<D: Dim> Physics<D> for Mechanics {
         }
         Some(StableStep {
             dt: best,
-            entity: format!("element {which}"),
+            entity: Entity::new(EntityKind::Element, which),
             physics: "mechanics".into(),
         })
     }

@@ -445,7 +445,11 @@ fn watchdog_names_step_and_node() {
         .build()
         .unwrap();
     let limit = sim.time_step_limit().unwrap().clone();
-    assert!(limit.entity.starts_with("element "), "{limit:?}");
+    assert_eq!(
+        limit.entity.kind,
+        pcdc_compute::EntityKind::Element,
+        "{limit:?}"
+    );
     assert!(limit.dt < 1e-3);
     let err = sim.run(100_000).unwrap_err();
     let msg = err.to_string();

@@ -45,6 +45,14 @@ pub enum Phase {
     /// After the velocity update, before the position update: prescribed velocities and
     /// constraints overwrite `v`.
     Kinematics,
+    /// After the position update, once per step ([`crate::Physics::post_update`]).
+    PostUpdate,
+    /// The physics' sub-cycled field stage ([`crate::Physics::field_step`]): its kernels
+    /// run as a group, repeated [`crate::SubCycle::substeps`] times after every step (or
+    /// once after every n-th step), each in order with a barrier between dispatches. The
+    /// backend adds `const FIELD_DT_SCALE: Real` to these kernels: the field step is
+    /// `p_dt() * FIELD_DT_SCALE`, exactly as on the CPU.
+    Field,
 }
 
 /// A constant spliced into a kernel's source.
@@ -151,6 +159,8 @@ pub(crate) struct Program {
     /// Buffer index of each field (FieldStore order).
     pub field_buffers: Vec<usize>,
     pub kernels: Vec<(Phase, Kernel)>,
+    /// Index of the physics that declared each kernel.
+    pub kernel_owner: Vec<usize>,
     pub signals: Vec<Signal>,
     /// Physics errors by code (index).
     pub errors: Vec<ErrorMessage>,
@@ -167,6 +177,7 @@ pub struct GpuSetup<'a, D: Dim> {
     pub(crate) slot_len: usize,
     pub(crate) program: &'a mut Program,
     pub(crate) physics: String,
+    pub(crate) physics_index: usize,
 }
 
 impl<D: Dim> GpuSetup<'_, D> {
@@ -282,6 +293,7 @@ impl<D: Dim> GpuSetup<'_, D> {
             }
         }
         self.program.kernels.push((phase, kernel));
+        self.program.kernel_owner.push(self.physics_index);
         Ok(())
     }
 }

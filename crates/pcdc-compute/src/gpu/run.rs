@@ -105,10 +105,11 @@ pub(crate) fn build_program<D: Dim>(
         buffers,
         field_buffers,
         kernels: Vec::new(),
+        kernel_owner: Vec::new(),
         signals: Vec::new(),
         errors: Vec::new(),
     };
-    for (p, r) in physics.iter_mut().zip(&layout.slot_ranges) {
+    for (index, (p, r)) in physics.iter_mut().zip(&layout.slot_ranges).enumerate() {
         let name = p.name().to_string();
         let mut setup = GpuSetup {
             mesh,
@@ -118,6 +119,7 @@ pub(crate) fn build_program<D: Dim>(
             slot_len: r.len(),
             program: &mut program,
             physics: name.clone(),
+            physics_index: index,
         };
         p.gpu_setup(&mut setup)?;
     }
@@ -144,6 +146,9 @@ pub(crate) struct GpuRun {
     errors: Vec<super::program::ErrorMessage>,
     forces: Vec<Pipeline>,
     kinematics: Vec<Pipeline>,
+    post_update: Vec<Pipeline>,
+    /// Field stages: each physics' kernel group with its sub-cycling.
+    field: Vec<(crate::SubCycle, Vec<Pipeline>)>,
     gather_integrate: Pipeline,
     gather_forces: Pipeline,
     update: Pipeline,
@@ -211,6 +216,7 @@ impl GpuRun {
             buffers: mut decls,
             field_buffers,
             kernels,
+            kernel_owner,
             signals,
             errors,
         } = program;
@@ -387,13 +393,31 @@ impl GpuRun {
         };
         let mut forces = Vec::new();
         let mut kinematics = Vec::new();
-        for (phase, k) in &kernels {
-            let p = make(k)?;
+        let mut post_update = Vec::new();
+        let mut field: Vec<(usize, crate::SubCycle, Vec<Pipeline>)> = Vec::new();
+        for ((phase, k), &owner) in kernels.iter().zip(&kernel_owner) {
             match phase {
-                Phase::Forces => forces.push(p),
-                Phase::Kinematics => kinematics.push(p),
+                Phase::Forces => forces.push(make(k)?),
+                Phase::Kinematics => kinematics.push(make(k)?),
+                Phase::PostUpdate => post_update.push(make(k)?),
+                Phase::Field => {
+                    let stage = sim.field_stages.get(owner).and_then(|s| s.as_ref());
+                    let Some(stage) = stage else {
+                        return Err(ComputeError::Gpu(format!(
+                            "kernel '{}' is in the field phase, but physics '{}' has no field stage (Physics::field_schedule)",
+                            k.label,
+                            sim.physics[owner].name()
+                        )));
+                    };
+                    let p = make(&k.clone().const_real("FIELD_DT_SCALE", stage.cycle.scale()))?;
+                    match field.last_mut() {
+                        Some(g) if g.0 == owner => g.2.push(p),
+                        _ => field.push((owner, stage.cycle, vec![p])),
+                    }
+                }
             }
         }
+        let field = field.into_iter().map(|(_, c, p)| (c, p)).collect();
         let mut builtins = builtin_kernels::<D>(sim.mesh.n_nodes())
             .into_iter()
             .map(|k| {
@@ -456,6 +480,8 @@ impl GpuRun {
             errors,
             forces,
             kinematics,
+            post_update,
+            field,
             gather_integrate,
             gather_forces,
             update,
@@ -614,6 +640,20 @@ impl GpuRun {
                         self.dispatch(&mut pass, &e.work);
                     }
                     self.dispatch(&mut pass, &self.update);
+                    for p in &self.post_update {
+                        self.dispatch(&mut pass, p);
+                    }
+                    let done = step + j as u64 + 1;
+                    for (cycle, group) in &self.field {
+                        if !cycle.runs_after(done) {
+                            continue;
+                        }
+                        for _ in 0..cycle.substeps() {
+                            for p in group {
+                                self.dispatch(&mut pass, p);
+                            }
+                        }
+                    }
                 }
             }
             self.backend.queue().submit([enc.finish()]);
@@ -830,8 +870,14 @@ impl GpuRun {
             .chain(std::iter::once(&self.gather_integrate))
             .chain(&self.kinematics)
             .chain(std::iter::once(&self.update))
+            .chain(&self.post_update)
             .map(|p| p.bytes)
-            .sum()
+            .sum::<u64>()
+            + self
+                .field
+                .iter()
+                .map(|(c, g)| c.substeps() as u64 * g.iter().map(|p| p.bytes).sum::<u64>())
+                .sum::<u64>()
     }
 
     /// Labels of the compiled kernels in dispatch order (for reports).
@@ -841,6 +887,8 @@ impl GpuRun {
             .chain(std::iter::once(&self.gather_integrate))
             .chain(&self.kinematics)
             .chain(std::iter::once(&self.update))
+            .chain(&self.post_update)
+            .chain(self.field.iter().flat_map(|(_, g)| g))
             .map(|p| p.label.clone())
             .collect()
     }

@@ -69,7 +69,7 @@ impl Physics<Dim2> for Springs {
     ) -> Option<StableStep> {
         Some(StableStep {
             dt: 2.0 * (kin.mass[0] / self.k).sqrt(),
-            entity: "node 0".into(),
+            entity: crate::Entity::new(crate::EntityKind::Node, 0),
             physics: "springs".into(),
         })
     }
