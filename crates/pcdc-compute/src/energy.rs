@@ -345,7 +345,7 @@ impl<D: Dim> Simulation<D> {
         let sp = &t.slot_phys;
         // Per chunk: work per physics, gravity, local damping, kinematic conditions.
         let parts: Vec<Vec<f64>> = self.backend.install(|| {
-            (0..self.mesh.n_nodes())
+            (0..self.n_nodes())
                 .into_par_iter()
                 .step_by(CHUNK)
                 .map(|start| {
@@ -465,7 +465,7 @@ impl<D: Dim> Simulation<D> {
         let d = D::D;
         let r = &self.slot_ranges[p];
         let mut best = (f64::NEG_INFINITY, None);
-        for n in 0..self.mesh.n_nodes() {
+        for n in 0..self.n_nodes() {
             for &s in &self.gather_idx[self.gather_ptr[n] as usize..self.gather_ptr[n + 1] as usize]
             {
                 let s = s as usize;

@@ -77,14 +77,14 @@ impl<D: Dim> History<D> {
         for (name, p) in &self.columns {
             match p {
                 Probe::NodeDisplacement { node, comp } | Probe::NodeVelocity { node, comp }
-                    if *node as usize >= sim.mesh().n_nodes() || *comp >= D::D =>
+                    if *node as usize >= sim.n_nodes() || *comp >= D::D =>
                 {
                     return Err(ComputeError::param(
                         format!("probe '{name}'"),
                         format!("node {node} comp {comp}"),
                         format!(
                             "out of range ({} nodes, {} components)",
-                            sim.mesh().n_nodes(),
+                            sim.n_nodes(),
                             D::D
                         ),
                     ));

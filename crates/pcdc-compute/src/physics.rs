@@ -143,10 +143,23 @@ pub struct FieldContext<'a, D: Dim> {
     pub backend: &'a Backend,
 }
 
+/// Handle to a block of nodes a physics added ([`InitContext::add_nodes`]): nodes
+/// `first..first + len` of the simulation, after the mesh nodes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NodeBlock {
+    /// Index of the first added node in the simulation's node arrays.
+    pub first: usize,
+    /// Number of nodes.
+    pub len: usize,
+}
+
 /// Read-only view of the kinematic state during a step.
 pub struct Kinematics<'a, D: Dim> {
     /// The mesh (reference configuration).
     pub mesh: &'a Mesh<D>,
+    /// Reference coordinates of every node (m), stride D: the mesh nodes, then the nodes
+    /// physics added ([`InitContext::add_nodes`]).
+    pub coords: &'a [f64],
     /// Physical lumped node mass (kg).
     pub mass: &'a [f64],
     /// Node displacement (m), stride D.
@@ -168,7 +181,7 @@ impl<D: Dim> Kinematics<'_, D> {
     /// Current position of node `n` component `k` (m).
     #[inline]
     pub fn x(&self, n: usize, k: usize) -> f64 {
-        self.mesh.coords()[n * D::D + k] + self.u[n * D::D + k]
+        self.coords[n * D::D + k] + self.u[n * D::D + k]
     }
 }
 
@@ -179,18 +192,25 @@ pub struct InitContext<'a, D: Dim> {
     /// Field storage (already holding every declared field).
     pub fields: &'a mut FieldStore,
     pub(crate) slot_nodes: Vec<u32>,
+    /// Nodes in the simulation before this physics' `add_nodes` calls.
+    pub(crate) n_nodes: usize,
+    /// Reference coordinates and masses of the nodes this physics adds.
+    pub(crate) added_coords: Vec<f64>,
+    pub(crate) added_mass: Vec<f64>,
 }
 
 impl<D: Dim> InitContext<'_, D> {
     /// Registers force slots: slot `i` of the block adds its `D` components to node
     /// `nodes[i]`. Nodes sum their slots in registration order (deterministic gather).
+    /// Slots may also act on nodes added with [`InitContext::add_nodes`] by this or an
+    /// earlier physics.
     pub fn register_slots(&mut self, nodes: &[u32]) -> Result<SlotBlock, ComputeError> {
-        let n = self.mesh.n_nodes() as u32;
+        let n = self.n_nodes() as u32;
         if let Some(&bad) = nodes.iter().find(|&&x| x >= n) {
             return Err(ComputeError::param(
                 "slot node",
                 bad,
-                format!("mesh has {n} nodes"),
+                format!("the simulation has {n} nodes"),
             ));
         }
         let first = self.slot_nodes.len();
@@ -198,6 +218,53 @@ impl<D: Dim> InitContext<'_, D> {
         Ok(SlotBlock {
             first,
             len: nodes.len(),
+        })
+    }
+
+    /// Nodes in the simulation so far: the mesh nodes and every node added up to now.
+    pub fn n_nodes(&self) -> usize {
+        self.n_nodes + self.added_mass.len()
+    }
+
+    /// Adds degrees of freedom this physics owns (e.g. bolt nodes, particles): nodes at
+    /// reference positions `coords` (m, stride D) with lumped masses `mass` (kg). They
+    /// are integrated by the same step as the mesh nodes (gravity, local damping,
+    /// watchdog, snapshots, both backends); the physics gives them forces through its
+    /// slots ([`InitContext::register_slots`]). Node fields (`Place::Node`) cover the
+    /// mesh nodes only.
+    pub fn add_nodes(&mut self, coords: &[f64], mass: &[f64]) -> Result<NodeBlock, ComputeError> {
+        if coords.len() != mass.len() * D::D {
+            return Err(ComputeError::param(
+                "added node coordinates",
+                coords.len(),
+                format!(
+                    "need {} values ({} nodes x {})",
+                    mass.len() * D::D,
+                    mass.len(),
+                    D::D
+                ),
+            ));
+        }
+        if let Some(i) = coords.iter().position(|x| !x.is_finite()) {
+            return Err(ComputeError::param(
+                format!("added node {} coordinate", i / D::D),
+                coords[i],
+                "must be finite",
+            ));
+        }
+        if let Some(i) = mass.iter().position(|m| !(*m > 0.0 && m.is_finite())) {
+            return Err(ComputeError::param(
+                format!("added node {i} mass"),
+                mass[i],
+                "must be positive and finite",
+            ));
+        }
+        let first = self.n_nodes();
+        self.added_coords.extend_from_slice(coords);
+        self.added_mass.extend_from_slice(mass);
+        Ok(NodeBlock {
+            first,
+            len: mass.len(),
         })
     }
 }
@@ -270,7 +337,8 @@ pub trait Physics<D: Dim>: Send + Sync {
     /// slots and sets initial field values.
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError>;
 
-    /// Adds this physics' lumped nodal mass (kg) into `mass` (one value per node).
+    /// Adds this physics' lumped nodal mass (kg) into `mass` (one value per node, the
+    /// added nodes included; their own masses are already in).
     /// With `scale_to_dt = Some(dt)` the mass of each contributing entity is scaled up
     /// where needed so that the entity is stable at `dt` (mass scaling for static
     /// relaxation).

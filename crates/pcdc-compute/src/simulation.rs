@@ -198,10 +198,11 @@ impl<D: Dim> SimulationBuilder<D> {
                 "must be positive",
             ));
         }
-        let n_nodes = mesh.n_nodes();
         let layout = prepare_layout(&mesh, &mut physics)?;
+        let n_nodes = layout.coords.len() / D::D;
         let fields = layout.fields.clone();
         let mut mass = vec![0.0; n_nodes];
+        mass[mesh.n_nodes()..].copy_from_slice(&layout.added_mass);
         for p in &physics {
             p.add_mass(&mesh, &fields, &mut mass, None);
         }
@@ -230,6 +231,7 @@ impl<D: Dim> SimulationBuilder<D> {
             gather_idx: layout.gather_idx.clone(),
             gpu: None,
             device_fresh: false,
+            coords: layout.coords.clone(),
             mesh,
             backend,
             physics,
@@ -264,6 +266,10 @@ impl<D: Dim> SimulationBuilder<D> {
 
 /// Fields, slots and the node -> slot gather lists of a composition.
 pub(crate) struct Layout {
+    /// Reference coordinates of every node: the mesh's, then the added ones.
+    pub coords: Vec<f64>,
+    /// Masses of the nodes physics added (kg).
+    pub added_mass: Vec<f64>,
     pub fields: FieldStore,
     pub slot_ranges: Vec<std::ops::Range<usize>>,
     pub n_slots: usize,
@@ -364,22 +370,29 @@ pub(crate) fn prepare_layout<D: Dim>(
     mesh: &Mesh<D>,
     physics: &mut [Box<dyn Physics<D>>],
 ) -> Result<Layout, ComputeError> {
-    let n_nodes = mesh.n_nodes();
     let fields = declare_fields(mesh, physics)?;
     let mut fields = fields;
     let mut slot_ranges = Vec::with_capacity(physics.len());
     let mut slot_nodes = Vec::new();
+    let mut coords = mesh.coords().to_vec();
+    let mut added_mass = Vec::new();
     for p in physics.iter_mut() {
         let mut ctx = InitContext {
             mesh,
             fields: &mut fields,
             slot_nodes: Vec::new(),
+            n_nodes: coords.len() / D::D,
+            added_coords: Vec::new(),
+            added_mass: Vec::new(),
         };
         p.init(&mut ctx)?;
         let first = slot_nodes.len();
         slot_nodes.extend_from_slice(&ctx.slot_nodes);
         slot_ranges.push(first..slot_nodes.len());
+        coords.extend_from_slice(&ctx.added_coords);
+        added_mass.extend_from_slice(&ctx.added_mass);
     }
+    let n_nodes = coords.len() / D::D;
     let mut gather_ptr = vec![0u32; n_nodes + 1];
     for &n in &slot_nodes {
         gather_ptr[n as usize + 1] += 1;
@@ -394,6 +407,8 @@ pub(crate) fn prepare_layout<D: Dim>(
         fill[n as usize] += 1;
     }
     Ok(Layout {
+        coords,
+        added_mass,
         fields,
         slot_ranges,
         n_slots: slot_nodes.len(),
@@ -407,6 +422,8 @@ pub struct Simulation<D: Dim> {
     /// The evolving state.
     pub state: State,
     pub(crate) mesh: Mesh<D>,
+    /// Reference coordinates of every node (mesh nodes, then added ones), stride D.
+    pub(crate) coords: Vec<f64>,
     pub(crate) backend: Backend,
     pub(crate) physics: Vec<Box<dyn Physics<D>>>,
     pub(crate) mass: Vec<f64>,
@@ -528,7 +545,7 @@ impl<D: Dim> Simulation<D> {
             return Ok(None);
         }
         let mut g = vec![0.0; force.len()];
-        for n in 0..self.mesh.n_nodes() {
+        for n in 0..self.n_nodes() {
             for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
                 for k in 0..d {
                     g[n * d + k] += slots[s as usize * d + k].abs();
@@ -549,6 +566,7 @@ impl<D: Dim> Simulation<D> {
             let mut ctx = ForceContext {
                 kin: Kinematics {
                     mesh: &self.mesh,
+                    coords: &self.coords,
                     mass: &self.mass_phys,
                     u: kin_u,
                     v: kin_v,
@@ -693,6 +711,7 @@ impl<D: Dim> Simulation<D> {
     pub fn kinematics(&self) -> Kinematics<'_, D> {
         Kinematics {
             mesh: &self.mesh,
+            coords: &self.coords,
             mass: &self.mass_phys,
             u: &self.state.u,
             v: &self.state.v,
@@ -794,10 +813,20 @@ impl<D: Dim> Simulation<D> {
             .sum()
     }
 
+    /// Number of nodes integrated: the mesh nodes, then the nodes physics added
+    /// ([`crate::InitContext::add_nodes`]).
+    pub fn n_nodes(&self) -> usize {
+        self.coords.len() / D::D
+    }
+
+    /// Reference coordinates of every node (m), stride D (mesh nodes, then added ones).
+    pub fn reference_coords(&self) -> &[f64] {
+        &self.coords
+    }
+
     /// Current position of every node (m), stride D.
     pub fn positions(&self) -> Vec<f64> {
-        self.mesh
-            .coords()
+        self.coords
             .iter()
             .zip(&self.state.u)
             .map(|(x, u)| x + u)

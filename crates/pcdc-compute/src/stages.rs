@@ -112,6 +112,7 @@ impl<D: Dim> Simulation<D> {
                 let mut ctx = FieldContext {
                     kin: crate::physics::Kinematics {
                         mesh: &self.mesh,
+                        coords: &self.coords,
                         mass: &self.mass_phys,
                         u: &self.state.u,
                         v: &self.state.v,
@@ -144,6 +145,7 @@ impl<D: Dim> Simulation<D> {
                 let mut ctx = FieldContext {
                     kin: crate::physics::Kinematics {
                         mesh: &self.mesh,
+                        coords: &self.coords,
                         mass: &self.mass_phys,
                         u: &self.state.u,
                         v: &self.state.v,

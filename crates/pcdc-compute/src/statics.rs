@@ -167,7 +167,7 @@ impl<D: Dim> Simulation<D> {
     pub fn solve_linear(&mut self, opts: &StaticOptions) -> Result<StaticReport, ComputeError> {
         check_opts(opts)?;
         let d = D::D;
-        let ndof = self.mesh.n_nodes() * d;
+        let ndof = self.n_nodes() * d;
         let mut trip = Vec::new();
         for p in &self.physics {
             p.linear_stiffness(&self.mesh, &self.state.fields, &mut trip)?;

@@ -115,6 +115,7 @@ pub(crate) fn setup<D: Dim>(
             let mass = vec![0.0; mesh.n_nodes()];
             let kin = pcdc_compute::Kinematics {
                 mesh,
+                coords: mesh.coords(),
                 mass: &mass,
                 u: &zeros,
                 v: &zeros,

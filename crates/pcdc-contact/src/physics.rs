@@ -1064,7 +1064,7 @@ mod tests {
                 v[2 * n + 1] = vy;
             }
             let mass = vec![1.0; 6];
-            let kin = Kinematics { mesh: &mesh, mass: &mass, u: &u, v: &v, time: 0.0, dt: 1e-3, step: 0, damping: false };
+            let kin = Kinematics { mesh: &mesh, coords: mesh.coords(), mass: &mass, u: &u, v: &v, time: 0.0, dt: 1e-3, step: 0, damping: false };
             let c = Contact::element_xy(&kin, 1);
             let t = Contact::element_xy(&kin, 0);
             let law = MohrCoulombContact {
@@ -1115,7 +1115,7 @@ mod tests {
                 v[3 * n + 2] = vz;
             }
             let mass = vec![1.0; 8];
-            let kin = Kinematics { mesh: &mesh, mass: &mass, u: &u, v: &v, time: 0.0, dt: 1e-3, step: 0, damping: false };
+            let kin = Kinematics { mesh: &mesh, coords: mesh.coords(), mass: &mass, u: &u, v: &v, time: 0.0, dt: 1e-3, step: 0, damping: false };
             let c = Contact::element_xyz(&kin, 1);
             let t = Contact::element_xyz(&kin, 0);
             let law = MohrCoulombContact {

@@ -10,6 +10,7 @@ fn boxes_at_rest(mesh: &Mesh<Dim3>, margin: f64) -> Vec<[f64; 6]> {
     let mass = vec![1.0; mesh.n_nodes()];
     let kin = Kinematics {
         mesh,
+        coords: mesh.coords(),
         mass: &mass,
         u: &u,
         v: &u,

@@ -124,7 +124,10 @@ pub fn write_step_with<D: Dim>(
     let stress = global_stress(sim)?;
     let principal = principal_stress::<D>(&stress);
     let strain = sim.field(names::STRAIN)?;
-    let x = sim.positions();
+    // The mesh's nodes only (nodes a physics added, e.g. bolt nodes, are not cells' nodes).
+    let nd = sim.mesh().n_nodes() * D::D;
+    let mut x = sim.positions();
+    x.truncate(nd);
     let np = if D::D == 2 { 2 } else { 3 };
     let p1: Vec<f64> = principal.iter().step_by(np).copied().collect();
     let pn: Vec<f64> = principal.iter().skip(np - 1).step_by(np).copied().collect();
@@ -156,7 +159,7 @@ pub fn write_step_with<D: Dim>(
         },
         DataArray::Vector {
             name: vn,
-            values: &sim.state.v,
+            values: &sim.state.v[..nd],
         },
     ];
     point_data.extend_from_slice(points);

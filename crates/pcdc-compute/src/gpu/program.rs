@@ -506,7 +506,7 @@ pub fn offline_kernel_sources<D: Dim>(
             assemble(k, precision, &|b| program.elem_of(b)),
         ));
     }
-    for k in crate::gpu::run::builtin_kernels::<D>(mesh.n_nodes()) {
+    for k in crate::gpu::run::builtin_kernels::<D>(layout.coords.len() / D::D) {
         let k = k.const_real("RUNAWAY2", 1.0);
         out.push((
             k.label.clone(),

@@ -60,18 +60,20 @@ pub(crate) fn build_program<D: Dim>(
     layout: &crate::simulation::Layout,
     precision: Precision,
 ) -> Result<Program, ComputeError> {
-    let nd = mesh.n_nodes() * D::D;
+    // Every node: the mesh's, then those physics added.
+    let nd = layout.coords.len();
+    let n_nodes = nd / D::D;
     let mut buffers = vec![
         decl(
             "coords",
             Elem::Real,
             nd,
-            Some(GpuData::Real(mesh.coords().to_vec())),
+            Some(GpuData::Real(layout.coords.clone())),
         ),
         decl("displacement", Elem::Real, nd, None),
         decl("velocity", Elem::Real, nd, None),
-        decl("mass", Elem::Real, mesh.n_nodes(), None),
-        decl("mass_phys", Elem::Real, mesh.n_nodes(), None),
+        decl("mass", Elem::Real, n_nodes, None),
+        decl("mass_phys", Elem::Real, n_nodes, None),
         decl("force", Elem::Real, nd, None),
         decl("slots", Elem::Real, layout.n_slots * D::D, None),
         decl(
@@ -222,12 +224,7 @@ impl GpuRun {
         } = program;
         // Energy balance buffers, only when tracking is on.
         let energy_buffers = sim.energy.is_some().then(|| {
-            super::energy::declare(
-                &mut decls,
-                sim.mesh.n_nodes(),
-                D::D,
-                layout.slot_ranges.len(),
-            )
+            super::energy::declare(&mut decls, sim.n_nodes(), D::D, layout.slot_ranges.len())
         });
         let eb = |e: Elem| match e {
             Elem::Real => precision.bytes(),
@@ -418,7 +415,7 @@ impl GpuRun {
             }
         }
         let field = field.into_iter().map(|(_, c, p)| (c, p)).collect();
-        let mut builtins = builtin_kernels::<D>(sim.mesh.n_nodes())
+        let mut builtins = builtin_kernels::<D>(sim.n_nodes())
             .into_iter()
             .map(|k| {
                 let k = if k.label == "update_watchdog" {
@@ -432,7 +429,7 @@ impl GpuRun {
         let energy = match energy_buffers {
             Some(b) => {
                 let [save, work] =
-                    super::energy::kernels(&b, sim.mesh.n_nodes(), D::D, &layout.slot_ranges);
+                    super::energy::kernels(&b, sim.n_nodes(), D::D, &layout.slot_ranges);
                 let staging = device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("energy read-back"),
                     size: buffers[b.acc].size(),

@@ -40,6 +40,7 @@ pub fn boxes_at_rest(mesh: &Mesh<Dim2>, margin: f64) -> Vec<[f64; 4]> {
     let mass = vec![1.0; mesh.n_nodes()];
     let kin = Kinematics {
         mesh,
+        coords: mesh.coords(),
         mass: &mass,
         u: &u,
         v: &u,
