@@ -453,7 +453,7 @@ pub struct Simulation<D: Dim> {
 }
 
 impl<D: Dim> Simulation<D> {
-    /// Starts a builder on `backend` (a [`Backend`], or a [`CpuBackend`] or GPU backend).
+    /// Starts a builder on `backend` (a [`Backend`], or a [`crate::CpuBackend`] or GPU backend).
     pub fn builder(mesh: Mesh<D>, backend: impl Into<Backend>) -> SimulationBuilder<D> {
         SimulationBuilder::new(mesh, backend)
     }
