@@ -49,7 +49,7 @@ pub use gpu::WgpuBackend;
 pub use history::{History, Probe};
 pub use physics::{
     DofConstraint, Entity, EntityKind, FieldContext, FieldSchedule, ForceContext, InitContext,
-    Kinematics, NodeBlock, Physics, SlotBlock, StableStep, SubCycle, VelocityContext,
+    Kinematics, NodeBlock, Physics, PhysicsGroup, SlotBlock, StableStep, SubCycle, VelocityContext,
 };
 pub use simulation::{Simulation, SimulationBuilder, State, DEFAULT_SAFETY};
 pub use stages::{FieldStage, MAX_SUBCYCLE};

@@ -297,6 +297,14 @@ pub struct VelocityContext<'a, D: Dim> {
     pub fields: &'a mut FieldStore,
 }
 
+/// Several physics composed by one call ([`crate::SimulationBuilder::group`]), e.g. the
+/// canonical FDEM composition (elements, cohesive joints on every interior face, contact
+/// with bonded neighbours excluded) of the `pcdc` facade.
+pub trait PhysicsGroup<D: Dim> {
+    /// The physics of the group, in the order they run.
+    fn into_physics(self) -> Vec<Box<dyn Physics<D>>>;
+}
+
 /// A linear constraint on one node's displacement used by the direct static solve.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum DofConstraint {

@@ -91,6 +91,12 @@ impl<D: Dim> SimulationBuilder<D> {
         self
     }
 
+    /// Adds every physics of a group ([`crate::PhysicsGroup`]), in the group's order.
+    pub fn group(mut self, g: impl crate::PhysicsGroup<D>) -> Self {
+        self.physics.extend(g.into_physics());
+        self
+    }
+
     /// Adds a boxed physics.
     pub fn boxed_physics(mut self, p: Box<dyn Physics<D>>) -> Self {
         self.physics.push(p);
