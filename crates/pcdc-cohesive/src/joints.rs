@@ -31,10 +31,10 @@ use pcdc_compute::{
     StableStep,
 };
 use pcdc_compute::{Entity, EntityKind};
-use pcdc_mesh::{Dim, Mesh, Range};
+use pcdc_mesh::{Dim, Interfaces, Mesh, Range};
 use rayon::prelude::*;
 
-use crate::{JointModel, Joints};
+use crate::JointModel;
 
 const JOINT_KERNEL: &str = include_str!("shaders/joints.wgsl");
 const JOINT_LIBRARY: &str = include_str!("shaders/joint_library.wgsl");
@@ -89,10 +89,13 @@ fn gauss_rule(d: usize, points: usize) -> Vec<([f64; 3], f64)> {
     }
 }
 
-/// Face-joints with their constitutive models, as a physics.
+/// Face-joints with their constitutive models, as a physics: one joint on every
+/// interface of the mesh ([`pcdc_mesh::Mesh::interfaces`], made by
+/// [`pcdc_mesh::split_nodes`]), in the interfaces' order.
 #[derive(Debug)]
 pub struct CohesiveJoints {
-    joints: Joints,
+    /// The mesh's interfaces (copied at init).
+    joints: Interfaces,
     assignments: Vec<(Range, Arc<dyn JointModel>)>,
     /// Assignments by joint index: (index into `assignments`, joints).
     explicit: Vec<(usize, Vec<u32>)>,
@@ -105,12 +108,19 @@ pub struct CohesiveJoints {
     ids: Option<[FieldId; 3]>,
 }
 
+impl Default for CohesiveJoints {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl CohesiveJoints {
-    /// Joints of a split mesh (see [`crate::split_nodes`]); assign models with
-    /// [`CohesiveJoints::model`].
-    pub fn new(joints: Joints) -> Self {
+    /// Joints on the interfaces of the simulation's mesh (split with
+    /// [`pcdc_mesh::split_nodes`]; a mesh without interfaces has no joints); assign
+    /// models with [`CohesiveJoints::model`].
+    pub fn new() -> Self {
         CohesiveJoints {
-            joints,
+            joints: Interfaces::default(),
             assignments: Vec::new(),
             explicit: Vec::new(),
             gauss_3d: 3,
@@ -145,11 +155,6 @@ impl CohesiveJoints {
         self
     }
 
-    /// The joints.
-    pub fn joints(&self) -> &Joints {
-        &self.joints
-    }
-
     /// History variables per Gauss point: the largest of the assigned models (≥ 1).
     fn assigned_state_len(&self) -> usize {
         self.assignments
@@ -173,7 +178,7 @@ impl CohesiveJoints {
         state: &mut [f64],
     ) -> f64 {
         let (d, npf) = (D::D, D::NODES_PER_FACE);
-        let nodes = &self.joints.nodes[j * 2 * npf..(j + 1) * 2 * npf];
+        let nodes = self.joints.joint_nodes(j);
         let mut mid = [0.0; 9];
         let mut gap = [0.0; 9];
         for k in 0..npf {
@@ -233,19 +238,19 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         // joint and the integration rule.
         let model_of: Vec<u32> = self.model_of.iter().map(|&m| u32::from(m)).collect();
         Fingerprint::new()
-            .u32s(&self.joints.nodes)
-            .u32s(&self.joints.elements)
-            .u32s(&self.joints.faces)
+            .u32s(self.joints.nodes())
+            .u32s(self.joints.elements())
+            .u32s(self.joints.faces())
             .debug(&self.models)
             .u32s(&model_of)
             .u64(self.gauss_3d as u64)
             .finish()
     }
 
-    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
+    fn fields(&self, mesh: &Mesh<D>) -> Vec<FieldUse> {
         let points = if D::D == 2 { 3 } else { self.gauss_3d };
         let ns = self.assigned_state_len();
-        let nj = self.joints.len();
+        let nj = mesh.interfaces().len();
         vec![
             JOINT_STATE.own_sized::<D>(Some(nj), Some(points * ns)),
             JOINT_DAMAGE.own_sized::<D>(Some(nj), None),
@@ -256,6 +261,8 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let mesh = ctx.mesh;
+        // The mesh checked its interfaces against itself when it was built or read.
+        self.joints = mesh.interfaces().clone();
         let nj = self.joints.len();
         let err = |m: String| ComputeError::physics("cohesive joints", m);
         if D::D == 3 && self.gauss_3d != 3 && self.gauss_3d != 7 {
@@ -264,22 +271,6 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                 self.gauss_3d,
                 "must be 3 or 7",
             ));
-        }
-        if self.joints.nodes.len() != nj * 2 * npf || self.joints.faces.len() != 2 * nj {
-            return Err(err(format!(
-                "joint arrays do not fit {} joints of {} nodes per side",
-                nj, npf
-            )));
-        }
-        if let Some(&bad) = self
-            .joints
-            .nodes
-            .iter()
-            .find(|&&n| n as usize >= mesh.n_nodes())
-        {
-            return Err(err(format!(
-                "joint node {bad} is not a node of the mesh (was the mesh split with split_nodes?)"
-            )));
         }
         if nj > 0 && self.assignments.is_empty() {
             return Err(err(
@@ -301,7 +292,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let mut mid = vec![0.0; d];
         for j in 0..nj {
             mid.fill(0.0);
-            for &n in &self.joints.nodes[j * 2 * npf..j * 2 * npf + npf] {
+            for &n in &self.joints.joint_nodes(j)[..npf] {
                 for c in 0..d {
                     mid[c] += mesh.node(n as usize)[c] / npf as f64;
                 }
@@ -341,8 +332,8 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         };
         self.h = (0..nj)
             .map(|j| {
-                0.5 * (mean_edge(self.joints.elements[2 * j] as usize)
-                    + mean_edge(self.joints.elements[2 * j + 1] as usize))
+                0.5 * (mean_edge(self.joints.elements()[2 * j] as usize)
+                    + mean_edge(self.joints.elements()[2 * j + 1] as usize))
             })
             .collect();
         let state = ctx.fields.id(JOINT_STATE)?;
@@ -361,7 +352,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
             }
         }
         self.ids = Some(ids);
-        ctx.register_slots(&self.joints.nodes)?;
+        ctx.register_slots(self.joints.nodes())?;
         Ok(())
     }
 
@@ -371,7 +362,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let mut mid = [0.0; 9];
         let mut n = [0.0; 3];
         for j in 0..self.joints.len() {
-            let nodes = &self.joints.nodes[j * 2 * npf..(j + 1) * 2 * npf];
+            let nodes = self.joints.joint_nodes(j);
             for k in 0..npf {
                 mid[k * D::D..(k + 1) * D::D].copy_from_slice(kin.mesh.node(nodes[k] as usize));
             }
@@ -430,8 +421,8 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let [damage, broken] = ctx.fields.get_many_mut([did, bid]);
         for (j, &dmg) in damage.iter().enumerate() {
             if dmg >= 1.0 {
-                broken[self.joints.faces[2 * j] as usize] = 1.0;
-                broken[self.joints.faces[2 * j + 1] as usize] = 1.0;
+                broken[self.joints.faces()[2 * j] as usize] = 1.0;
+                broken[self.joints.faces()[2 * j + 1] as usize] = 1.0;
             }
         }
         Ok(())
@@ -484,8 +475,8 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let info_stride = 2 * npf + 4;
         let mut info = Vec::with_capacity(nj * info_stride);
         for j in 0..nj {
-            info.extend_from_slice(&self.joints.nodes[j * 2 * npf..(j + 1) * 2 * npf]);
-            info.extend_from_slice(&self.joints.faces[2 * j..2 * j + 2]);
+            info.extend_from_slice(self.joints.joint_nodes(j));
+            info.extend_from_slice(&self.joints.faces()[2 * j..2 * j + 2]);
             info.extend_from_slice(&model_info[self.model_of[j] as usize]);
         }
         let info = setup.upload("joint info", GpuData::U32(info));
@@ -526,10 +517,10 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
 #[cfg(test)]
 mod gpu_tests {
     use super::*;
-    use crate::{split_nodes, IntrinsicCzm, IntrinsicCzmParams, MohrCoulombJointParams, Traction};
+    use crate::{IntrinsicCzm, IntrinsicCzmParams, MohrCoulombJointParams, Traction};
     use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
     use pcdc_compute::Precision;
-    use pcdc_mesh::builders;
+    use pcdc_mesh::{builders, split_nodes};
 
     /// A joint model without a WGSL body (CPU only).
     #[derive(Debug)]
@@ -569,7 +560,7 @@ mod gpu_tests {
 
     /// Both built-in models (CZM everywhere, Mohr-Coulomb on one half, a second CZM
     /// with other parameters that shares the first one's WGSL function).
-    fn joints(j: Joints, gauss_3d: usize) -> CohesiveJoints {
+    fn joints(gauss_3d: usize) -> CohesiveJoints {
         let half = Range::HalfSpace {
             point: [0.5, 0.0, 0.0],
             normal: [1.0, 0.0, 0.0],
@@ -586,7 +577,7 @@ mod gpu_tests {
         }
         .build()
         .unwrap();
-        CohesiveJoints::new(j)
+        CohesiveJoints::new()
             .model(Range::All, czm())
             .model(
                 half,
@@ -610,22 +601,10 @@ mod gpu_tests {
         let s2 = split_nodes(&m2, &Range::All).unwrap();
         let s3 = split_nodes(&m3, &Range::All).unwrap();
         for p in [Precision::F64, Precision::F32] {
-            let k2 = offline_kernel_sources::<_>(
-                &s2.mesh,
-                vec![Box::new(joints(s2.joints.clone(), 3))],
-                p,
-            )
-            .unwrap();
+            let k2 = offline_kernel_sources::<_>(&s2, vec![Box::new(joints(3))], p).unwrap();
             let mut all = k2.clone();
             for g in [3, 7] {
-                all.extend(
-                    offline_kernel_sources::<_>(
-                        &s3.mesh,
-                        vec![Box::new(joints(s3.joints.clone(), g))],
-                        p,
-                    )
-                    .unwrap(),
-                );
+                all.extend(offline_kernel_sources::<_>(&s3, vec![Box::new(joints(g))], p).unwrap());
             }
             let joint_kernels: Vec<_> = all
                 .iter()
@@ -646,7 +625,7 @@ mod gpu_tests {
     #[test]
     fn no_joints_no_kernel() {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
-        let j = CohesiveJoints::new(Joints::default());
+        let j = CohesiveJoints::new();
         let k = offline_kernel_sources::<_>(&m2, vec![Box::new(j)], Precision::F64).unwrap();
         assert!(k.iter().all(|(l, _)| !l.starts_with("cohesive joints")));
     }
@@ -655,11 +634,10 @@ mod gpu_tests {
     fn joint_model_without_wgsl_is_a_build_error_naming_it() {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
         let s2 = split_nodes(&m2, &Range::All).unwrap();
-        let j = CohesiveJoints::new(s2.joints)
+        let j = CohesiveJoints::new()
             .model(Range::All, czm())
             .model_for(vec![0], CpuOnly);
-        let err =
-            offline_kernel_sources::<_>(&s2.mesh, vec![Box::new(j)], Precision::F64).unwrap_err();
+        let err = offline_kernel_sources::<_>(&s2, vec![Box::new(j)], Precision::F64).unwrap_err();
         assert!(matches!(err, ComputeError::NoGpuKernel { .. }), "{err:?}");
         let msg = err.to_string();
         assert!(

@@ -4,9 +4,9 @@
 //! [`JointModel`] plugin trait, starting with the intrinsic cohesive zone model
 //! [`IntrinsicCzm`] (eq. 63-73: penalties, peak opening and slip, damage D, softening
 //! f(D) with A = 0.63, B = 1.8, C = 6.0, Mohr-Coulomb shear strength, unloading along
-//! the secant, softening lengths from G_f1 and G_f2), and node splitting
-//! ([`split_nodes`]) that gives the elements of FDEM regions their own nodes and puts a
-//! face-joint on every interior face.
+//! the secant, softening lengths from G_f1 and G_f2), integrated over the face-joints of
+//! a mesh split by [`pcdc_mesh::split_nodes`] (the mesh carries them as its
+//! [`pcdc_mesh::Interfaces`], which every physics reads).
 //!
 //! The joint models ([`IntrinsicCzm`], [`MohrCoulombJoint`]) are built from parameter
 //! structs with named fields ([`IntrinsicCzmParams`], [`MohrCoulombJointParams`]) and
@@ -27,7 +27,6 @@ mod error;
 pub mod fractures;
 mod joints;
 mod model;
-mod split;
 
 pub use error::CohesiveError;
 pub use fractures::{joints_on_fractures, Distribution, Fracture, FractureNetwork};
@@ -37,4 +36,3 @@ pub use model::{
     IntrinsicCzmParams, JointModel, MohrCoulombJoint, MohrCoulombJointParams, Traction,
     WgslJointModel, SOFTENING_A, SOFTENING_B, SOFTENING_C,
 };
-pub use split::{split_nodes, Joints, SplitMesh};

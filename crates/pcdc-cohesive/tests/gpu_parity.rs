@@ -23,13 +23,13 @@
 //! skip (and fail with PCDC_REQUIRE_GPU=1).
 
 use pcdc_cohesive::{
-    joints_on_fractures, split_nodes, CohesiveJoints, Fracture, IntrinsicCzmParams,
-    MohrCoulombJointParams, BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE,
+    joints_on_fractures, CohesiveJoints, Fracture, IntrinsicCzmParams, MohrCoulombJointParams,
+    BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE,
 };
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_mech::{LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh, Range};
+use pcdc_mesh::{builders, split_nodes, Dim, Dim2, Dim3, Mesh, Range};
 
 const E: f64 = 30e9;
 /// Cell size of the bars (m).
@@ -141,12 +141,12 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
     }
     .build()
     .unwrap();
-    let mut joints = CohesiveJoints::new(split.joints.clone())
+    let mut joints = CohesiveJoints::new()
         .model(Range::All, strong)
         .model(band, weak)
         .gauss_points_3d(s.gauss_3d);
     if let Some(f) = s.fracture.clone() {
-        let on = joints_on_fractures(&split.mesh, &split.joints, &[f]).unwrap();
+        let on = joints_on_fractures(&split, &[f]).unwrap();
         assert!(!on.is_empty());
         joints = joints.model_for(
             on,
@@ -164,7 +164,7 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
         .unwrap()
         .with_damping(0.1)
         .unwrap();
-    let mut sim = Simulation::builder(split.mesh.clone(), backend)
+    let mut sim = Simulation::builder(split.clone(), backend)
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(joints)
         .build()
@@ -175,7 +175,7 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
     let x = sim.mesh().coords().to_vec();
     let mid = 0.5 * (lo[axis] + hi[axis]);
     for n in 0..sim.mesh().n_nodes() {
-        let m = split.master[n] as usize;
+        let m = split.interfaces().master()[n] as usize;
         let xi = (x[n * d + axis] - mid) / (0.5 * len);
         sim.state.v[n * d + axis] = s.pull * xi * (1.0 + 0.05 * noise(m * d + axis));
         sim.state.v[n * d] += s.shear * xi * (1.0 + 0.05 * noise(m * d));
@@ -370,9 +370,9 @@ fn joint_forces_agree_to_rounding() {
         .build()
         .unwrap();
         let soft = LinearElastic::new(1.0, 0.25, 2600.0).unwrap();
-        let mut sim = Simulation::builder(split.mesh, backend)
+        let mut sim = Simulation::builder(split, backend)
             .physics(Mechanics::new().material(Range::All, soft))
-            .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
+            .physics(CohesiveJoints::new().model(Range::All, czm))
             .build()
             .unwrap();
         for (i, u) in sim.state.u.iter_mut().enumerate() {

@@ -313,9 +313,9 @@ impl Contact {
     /// `elements` holds the two elements of each bond (stride 2), `faces` one face per bond
     /// (the bond's face on either side), and `broken_field` names a face field that is 0
     /// while the bond holds and non-zero once it is broken. For FDEM regions from
-    /// `pcdc_cohesive::split_nodes`: `joints.elements`, every other entry of
-    /// `joints.faces`, and `pcdc_cohesive::BROKEN_FACE`, so broken joint faces become
-    /// contact faces.
+    /// `pcdc_mesh::split_nodes`: `mesh.interfaces().elements()`, every other entry of
+    /// `mesh.interfaces().faces()`, and `pcdc_cohesive::BROKEN_FACE`, so broken joint
+    /// faces become contact faces.
     pub fn bonded_pairs(
         mut self,
         elements: &[u32],
