@@ -8,9 +8,12 @@
 //! together) and the shear magnitude τ (against the slip); side A receives
 //! `w A N_k (σ n + τ s/|s|)` and side B the opposite (exact action-reaction).
 //!
-//! Fields: `joint_state` (model history per Gauss point), `joint_damage` (largest D per
-//! joint, for output), and `broken_face` (1 on both faces of a fully broken joint, on
-//! the split mesh's faces: the field contact picks up).
+//! Fields ([`crate::fields`]): `joint_state` (model history per Gauss point),
+//! `joint_damage` (largest D per joint, for output), `broken_face` (1 on both faces of a
+//! fully broken joint, on the split mesh's faces: the field contact picks up), and per
+//! joint the kinematics other physics read: `joint_opening` (δ̄·n at the face centroid),
+//! `joint_sliding` (δ̄ − (δ̄·n) n, D components) and `joint_normal` (n), written by the
+//! same kernel, for broken joints too.
 //!
 //! A broken joint (largest damage 1) transfers no force from the next step on, whatever
 //! its model: its faces interact through contact alone. Integrating it further would
@@ -25,30 +28,41 @@
 use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
-use pcdc_compute::{Components, FieldKey, FieldUse, Place};
 use pcdc_compute::{
     ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
     StableStep,
 };
 use pcdc_compute::{Entity, EntityKind};
+use pcdc_compute::{FieldKey, FieldUse};
 use pcdc_mesh::{Dim, Interfaces, Mesh, Range};
 use rayon::prelude::*;
 
+use crate::fields::{
+    BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
+};
 use crate::JointModel;
 
 const JOINT_KERNEL: &str = include_str!("shaders/joints.wgsl");
 const JOINT_LIBRARY: &str = include_str!("shaders/joint_library.wgsl");
 
-/// Name of the joint history field.
-pub const JOINT_STATE: FieldKey =
-    FieldKey::new("joint_state", Place::Entities, Components::Declared);
-/// Name of the per-joint damage field (largest D over the Gauss points).
-pub const JOINT_DAMAGE: FieldKey =
-    FieldKey::new("joint_damage", Place::Entities, Components::Fixed(1));
-/// Name of the face field flagging the faces of broken joints (1 = broken).
-pub const BROKEN_FACE: FieldKey = FieldKey::new("broken_face", Place::Face, Components::Fixed(1));
-
 const CHUNK: usize = 256;
+
+/// Declares a per-joint field this physics owns: one value set per joint (interface) of
+/// the mesh, `components` values each (`None`: the key's). The one place to change when
+/// joints become a named entity set.
+fn own_per_joint<D: Dim>(key: FieldKey, n_joints: usize, components: Option<usize>) -> FieldUse {
+    key.own_sized::<D>(Some(n_joints), components)
+}
+
+/// Where [`CohesiveJoints::joint`] writes joint `j`'s published kinematics.
+struct JointOut<'a> {
+    /// Normal opening (m).
+    opening: &'a mut f64,
+    /// Sliding vector (m), D components.
+    sliding: &'a mut [f64],
+    /// Unit normal, D components.
+    normal: &'a mut [f64],
+}
 
 /// Gauss points on a joint face: (shape function values, weight as a fraction of the
 /// face measure).
@@ -105,7 +119,7 @@ pub struct CohesiveJoints {
     h: Vec<f64>,
     rule: Vec<([f64; 3], f64)>,
     n_state: usize,
-    ids: Option<[FieldId; 3]>,
+    ids: Option<[FieldId; 6]>,
 }
 
 impl Default for CohesiveJoints {
@@ -169,14 +183,18 @@ impl CohesiveJoints {
         self.rule.len() * self.n_state
     }
 
-    /// Joint `j`'s forces into `slots` (2·NPF·D values) and its state update.
+    /// Joint `j`'s opening, sliding and normal into `out` and, unless it is `broken`
+    /// (then its slots are zeroed and its damage returned unchanged as `None`), its
+    /// forces into `slots` (2·NPF·D values), its state update and its damage.
     fn joint<D: Dim>(
         &self,
         j: usize,
         kin: &Kinematics<'_, D>,
         slots: &mut [f64],
         state: &mut [f64],
-    ) -> f64 {
+        out: JointOut<'_>,
+        broken: bool,
+    ) -> Option<f64> {
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let nodes = self.joints.joint_nodes(j);
         let mut mid = [0.0; 9];
@@ -193,7 +211,29 @@ impl CohesiveJoints {
         }
         let mut n = [0.0; 3];
         let area = D::face_measure_normal(&mid[..npf * d], &mut n[..d]);
+        // Published kinematics: the gap at the face centroid (mean of the node-pair
+        // gaps) split along the normal.
+        let mut g = [0.0; 3];
+        for k in 0..npf {
+            for c in 0..d {
+                g[c] += gap[k * d + c];
+            }
+        }
+        let mut o = 0.0;
+        for c in 0..d {
+            g[c] /= npf as f64;
+            o += g[c] * n[c];
+        }
+        *out.opening = o;
+        for c in 0..d {
+            out.sliding[c] = g[c] - o * n[c];
+            out.normal[c] = n[c];
+        }
         slots.fill(0.0);
+        if broken {
+            // No force: contact alone acts between its faces.
+            return None;
+        }
         let model = &self.models[self.model_of[j] as usize];
         let ns = self.n_state;
         let mut damage = 0.0f64;
@@ -224,7 +264,7 @@ impl CohesiveJoints {
                 }
             }
         }
-        damage
+        Some(damage)
     }
 }
 
@@ -252,9 +292,12 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let ns = self.assigned_state_len();
         let nj = mesh.interfaces().len();
         vec![
-            JOINT_STATE.own_sized::<D>(Some(nj), Some(points * ns)),
-            JOINT_DAMAGE.own_sized::<D>(Some(nj), None),
+            own_per_joint::<D>(JOINT_STATE, nj, Some(points * ns)),
+            own_per_joint::<D>(JOINT_DAMAGE, nj, None),
             BROKEN_FACE.own::<D>(),
+            own_per_joint::<D>(JOINT_OPENING, nj, None),
+            own_per_joint::<D>(JOINT_SLIDING, nj, None),
+            own_per_joint::<D>(JOINT_NORMAL, nj, None),
         ]
     }
 
@@ -341,6 +384,9 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
             state,
             ctx.fields.id(JOINT_DAMAGE)?,
             ctx.fields.id(BROKEN_FACE)?,
+            ctx.fields.id(JOINT_OPENING)?,
+            ctx.fields.id(JOINT_SLIDING)?,
+            ctx.fields.id(JOINT_NORMAL)?,
         ];
         let stride = self.state_stride();
         let st = ctx.fields.get_mut(state);
@@ -393,28 +439,42 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
     }
 
     fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
-        let [sid, did, bid] = self.ids.expect("init ran");
+        let [sid, did, bid, oid, lid, nid] = self.ids.expect("init ran");
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let stride = self.state_stride();
         let kin = &ctx.kin;
-        let [state, damage] = ctx.fields.get_many_mut([sid, did]);
+        let [state, damage, opening, sliding, normal] =
+            ctx.fields.get_many_mut([sid, did, oid, lid, nid]);
         let slots = &mut *ctx.slots;
         ctx.backend.install(|| {
             slots
                 .par_chunks_mut(CHUNK * 2 * npf * d)
                 .zip(state.par_chunks_mut(CHUNK * stride))
                 .zip(damage.par_chunks_mut(CHUNK))
+                .zip(opening.par_chunks_mut(CHUNK))
+                .zip(sliding.par_chunks_mut(CHUNK * d))
+                .zip(normal.par_chunks_mut(CHUNK * d))
                 .enumerate()
-                .for_each(|(c, ((sl, st), dm))| {
+                .for_each(|(c, (((((sl, st), dm), op), sd), nm))| {
                     for i in 0..dm.len() {
                         let j = c * CHUNK + i;
-                        let sl = &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d];
-                        if dm[i] >= 1.0 {
-                            // Broken: no force; contact alone acts between its faces.
-                            sl.fill(0.0);
-                            continue;
+                        let out = JointOut {
+                            opening: &mut op[i],
+                            sliding: &mut sd[i * d..(i + 1) * d],
+                            normal: &mut nm[i * d..(i + 1) * d],
+                        };
+                        // A broken joint transfers no force; its kinematics are still
+                        // published.
+                        if let Some(dmg) = self.joint::<D>(
+                            j,
+                            kin,
+                            &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d],
+                            &mut st[i * stride..(i + 1) * stride],
+                            out,
+                            dm[i] >= 1.0,
+                        ) {
+                            dm[i] = dmg;
                         }
-                        dm[i] = self.joint::<D>(j, kin, sl, &mut st[i * stride..(i + 1) * stride]);
                     }
                 })
         });
@@ -509,6 +569,21 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                 Access::ReadWrite,
             )
             .bind("broken_face", setup.field(BROKEN_FACE)?, Access::ReadWrite)
+            .bind(
+                "joint_opening",
+                setup.field(JOINT_OPENING)?,
+                Access::ReadWrite,
+            )
+            .bind(
+                "joint_sliding",
+                setup.field(JOINT_SLIDING)?,
+                Access::ReadWrite,
+            )
+            .bind(
+                "joint_normal",
+                setup.field(JOINT_NORMAL)?,
+                Access::ReadWrite,
+            )
             .bind("slots", setup.slots(), Access::ReadWrite);
         setup.kernel(Phase::Forces, kernel)
     }

@@ -14,6 +14,9 @@
 //! one check, so a model read from a file is validated and its cached derived constants
 //! are always built from the parameters it holds.
 //!
+//! [`CohesiveJoints`] publishes per joint, for other physics to read, the normal opening,
+//! the sliding vector and the unit normal ([`fields`]), computed with the joint forces.
+//!
 //! Joints run on both backends: [`CohesiveJoints`] has a GPU kernel into which each
 //! model's WGSL body ([`JointModel::wgsl`], [`WgslJointModel`]) is spliced; the built-in
 //! models provide one, and the softening curve uses the hand-written [`portable_exp`] on
@@ -24,13 +27,17 @@
 #![allow(clippy::needless_range_loop)]
 
 mod error;
+pub mod fields;
 pub mod fractures;
 mod joints;
 mod model;
 
 pub use error::CohesiveError;
+pub use fields::{
+    BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
+};
 pub use fractures::{joints_on_fractures, Distribution, Fracture, FractureNetwork};
-pub use joints::{CohesiveJoints, BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE};
+pub use joints::CohesiveJoints;
 pub use model::{
     czm_state, portable_exp, softening, softening_integral, FailureMode, IntrinsicCzm,
     IntrinsicCzmParams, JointModel, MohrCoulombJoint, MohrCoulombJointParams, Traction,
