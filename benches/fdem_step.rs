@@ -37,14 +37,6 @@ fn scene_with(cells_x: usize, backend: Backend, contact: bool) -> Simulation<Dim
     let h = 0.05 / cells_x as f64;
     let mesh = builders::rectangle(0.0, 0.0, 0.05, 0.10, h).unwrap();
     let split = split_nodes(&mesh, &Range::All).unwrap();
-    let bond_elements = split.interfaces().elements().to_vec();
-    let bond_faces: Vec<u32> = split
-        .interfaces()
-        .faces()
-        .iter()
-        .step_by(2)
-        .copied()
-        .collect();
     let czm = IntrinsicCzmParams {
         friction_deg: 30.0,
         cohesion: 10e6,
@@ -66,7 +58,7 @@ fn scene_with(cells_x: usize, backend: Backend, contact: bool) -> Simulation<Dim
         b = b.physics(
             Contact::new(10.0 * E)
                 .friction(30.0, 10.0 * E)
-                .bonded_pairs(&bond_elements, &bond_faces, pcdc_cohesive::BROKEN_FACE),
+                .bonded_interfaces(pcdc_cohesive::BROKEN_FACE),
         );
     }
     b.physics(

@@ -92,16 +92,9 @@ fn run_perturbed(scale: f64, u: Units, steps: u64, eps: f64) -> Outcome {
     }
     .build()
     .unwrap();
-    let faces: Vec<u32> = split
-        .interfaces()
-        .faces()
-        .iter()
-        .step_by(2)
-        .copied()
-        .collect();
     let contact = Contact::new(10.0 * e)
         .friction(30.0, 10.0 * e)
-        .bonded_pairs(split.interfaces().elements(), &faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     // The base below its top face and the wall behind its front face are held.
     let fixed = Range::rect(len(-1.0), len(-1.0), len(1.0), len(0.0199)).or(Range::rect(
         len(0.2001),
@@ -248,16 +241,9 @@ fn run_3d(u: Units, steps: u64, eps: f64) -> Outcome {
     }
     .build()
     .unwrap();
-    let faces: Vec<u32> = split
-        .interfaces()
-        .faces()
-        .iter()
-        .step_by(2)
-        .copied()
-        .collect();
     let contact = Contact::new(10.0 * e)
         .friction(30.0, 10.0 * e)
-        .bonded_pairs(split.interfaces().elements(), &faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     let fixed = Range::cuboid([len(-1.0); 3], [len(1.0), len(1.0), len(0.0199)]);
     let mut sim = Simulation::builder(split, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))

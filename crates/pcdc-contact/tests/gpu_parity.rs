@@ -93,16 +93,9 @@ fn fdem(backend: Backend, perturb: f64) -> Outcome {
     .build()
     .unwrap();
     let joints = CohesiveJoints::new().model(Range::All, czm);
-    let bond_faces: Vec<u32> = split
-        .interfaces()
-        .faces()
-        .iter()
-        .step_by(2)
-        .copied()
-        .collect();
     let contact = Contact::new(10.0 * E)
         .friction(20.0, 10.0 * E)
-        .bonded_pairs(split.interfaces().elements(), &bond_faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
     let mut sim = Simulation::builder(split.clone(), backend)
         .physics(Mechanics::new().material(Range::All, rock))

@@ -38,16 +38,9 @@ fn fdem(x_struck: f64, friction: f64) -> Simulation<Dim2> {
     }
     .build()
     .unwrap();
-    let bond_faces: Vec<u32> = split
-        .interfaces()
-        .faces()
-        .iter()
-        .step_by(2)
-        .copied()
-        .collect();
     let contact = Contact::new(10.0 * E)
         .friction(friction, 10.0 * E)
-        .bonded_pairs(split.interfaces().elements(), &bond_faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
     let mut sim = Simulation::builder(split.clone(), Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))

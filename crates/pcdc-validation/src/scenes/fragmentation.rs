@@ -119,7 +119,6 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     // FDEM region: the block (inside the box); the walls keep shared nodes.
     let inside = Range::rect(1e-9, 1e-9, BOX_W - 1e-9, BOX_H - 1e-9);
     let mut mesh = split_nodes(&mesh, &inside)?;
-    let joints = mesh.interfaces().clone();
     let mut wall_nodes: Vec<u32> = (0..n_walls)
         .flat_map(|e| mesh.element(e).to_vec())
         .collect();
@@ -138,11 +137,10 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         penalty_overlap: 10.0 * E,
     }
     .build()?;
-    let bond_faces: Vec<u32> = joints.faces().iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * E)
         .friction(30.0, 10.0 * E)
-        .bonded_pairs(joints.elements(), &bond_faces, BROKEN_FACE);
-    let n_joints = joints.len();
+        .bonded_interfaces(BROKEN_FACE);
+    let n_joints = mesh.interfaces().len();
     let mut sim = Simulation::builder(mesh, backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(CohesiveJoints::new().model(Range::All, czm))

@@ -621,11 +621,9 @@ pub(crate) fn run(
     }
     .model()?;
     let czm = s.joints.model(e)?;
-    let bond_elements = joints.elements().to_vec();
-    let bond_faces: Vec<u32> = joints.faces().iter().step_by(2).copied().collect();
     let contact = Contact::new(s.contact.penalty * e)
         .friction(s.contact.friction_deg, s.contact.penalty * e)
-        .bonded_pairs(&bond_elements, &bond_faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     let v = s.loading.platen_velocity;
     let ramp = s.loading.ramp_time.max(0.0);
     let table = |sign: f64| -> Result<TimeValue, pcdc_compute::ComputeError> {
