@@ -1,6 +1,9 @@
 //! Typed keys of the fields [`crate::CohesiveJoints`] owns, for other physics to read
 //! (declare the use with [`FieldKey::read`] or [`FieldKey::read_lagged`]) and for output
 //! (`Simulation::field(key)`; on the GPU backend they come back with every read-back).
+//! The joint kinematics ([`JOINT_OPENING`], [`JOINT_SLIDING`], [`JOINT_NORMAL`]) are the
+//! shared keys of `pcdc_compute::names`, re-exported here, so that a physics crate
+//! reads them without depending on this one.
 //!
 //! The per-joint fields hold one value set per joint, in the order of the mesh's
 //! interfaces ([`pcdc_mesh::Mesh::interfaces`]): joint `j` is interface `j`, whose
@@ -41,13 +44,6 @@ pub const JOINT_DAMAGE: FieldKey =
     FieldKey::new("joint_damage", Place::Entities, Components::Fixed(1));
 /// Face field: 1 on both faces of a broken joint, else 0 (what contact reads).
 pub const BROKEN_FACE: FieldKey = FieldKey::new("broken_face", Place::Face, Components::Fixed(1));
-/// Normal opening o = δ̄·n of each joint (m, 1 value per joint; positive when open).
-pub const JOINT_OPENING: FieldKey =
-    FieldKey::new("joint_opening", Place::Entities, Components::Fixed(1));
-/// Sliding s = δ̄ − o n of each joint (m, D values per joint: a vector in global axes,
-/// orthogonal to the normal; |s| is the sliding distance).
-pub const JOINT_SLIDING: FieldKey =
-    FieldKey::new("joint_sliding", Place::Entities, Components::Vector);
-/// Unit normal n of each joint's midplane, from side A to side B (D values per joint).
-pub const JOINT_NORMAL: FieldKey =
-    FieldKey::new("joint_normal", Place::Entities, Components::Vector);
+// The joint kinematics are read by physics that must not depend on this crate (fluid
+// flow, bolts): their keys are the shared ones of pcdc-compute.
+pub use pcdc_compute::names::{JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING};

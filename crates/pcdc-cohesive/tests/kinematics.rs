@@ -11,9 +11,12 @@
 use pcdc_cohesive::{
     CohesiveJoints, IntrinsicCzmParams, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING,
 };
-use pcdc_compute::{Backend, Simulation};
+use pcdc_compute::{
+    names, Backend, ComputeError, FieldId, FieldUse, ForceContext, InitContext, Physics, Simulation,
+};
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{split_nodes, Dim, Dim2, Dim3, Mesh, Range};
+use std::sync::{Arc, Mutex};
 
 /// Tolerance on gaps (m): positions are X + u with |X| ~ 1 m, so a gap carries a few
 /// ulps of the coordinates (2.2e-16 m each), whatever its size.
@@ -191,4 +194,62 @@ fn opening_sliding_normal_3d_closed_form() {
     let slide = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
     // Tilting the midplane by ~µm/m tilts n by as much: the sliding is second order.
     assert!(slide <= 1e-10, "sliding {s:?}");
+}
+
+/// Another physics reading the opening through the shared key (as pcdc-hydro will, with
+/// no dependency on pcdc-cohesive): declared as a reader of the current step, it runs
+/// after the joints and sees this step's values.
+struct OpeningReader {
+    id: Option<FieldId>,
+    seen: Arc<Mutex<Vec<f64>>>,
+}
+
+impl<D: Dim> Physics<D> for OpeningReader {
+    fn name(&self) -> &str {
+        "opening reader"
+    }
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
+        vec![names::JOINT_OPENING.read::<D>()]
+    }
+    fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
+        self.id = Some(ctx.fields.id(names::JOINT_OPENING)?);
+        Ok(())
+    }
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+        let id = self.id.expect("init ran");
+        *self.seen.lock().unwrap() = ctx.fields.get(id).to_vec();
+        Ok(())
+    }
+}
+
+#[test]
+fn another_physics_reads_the_opening_through_the_shared_key() {
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let soft = LinearElastic::new(1e6, 0.25, 2600.0).unwrap();
+    let czm = IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 2e6,
+        tensile_strength: 1e6,
+        gf1: 0.01,
+        gf2: 0.1,
+        penalty_open: 3e11,
+        penalty_shear: 3e11,
+        penalty_overlap: 3e12,
+    }
+    .build()
+    .unwrap();
+    let mut sim = Simulation::builder(two_tets(), Backend::cpu(1).unwrap())
+        .physics(Mechanics::new().material(Range::All, soft))
+        .physics(CohesiveJoints::new().model(Range::All, czm))
+        .physics(OpeningReader {
+            id: None,
+            seen: seen.clone(),
+        })
+        .build()
+        .unwrap();
+    assert_eq!(JOINT_OPENING, names::JOINT_OPENING);
+    let d = [0.0, 0.0, -4e-7];
+    let (o, _, _) = evaluate(&mut sim, |_| d, d);
+    assert!((o - 4e-7).abs() <= TOL, "opening {o:e}");
+    assert_eq!(*seen.lock().unwrap(), vec![o]);
 }
