@@ -18,11 +18,11 @@
 //! joint-steps/s = triangle-steps/s x joints/triangles (about 1.5), printed once per mesh.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams};
+use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams};
 use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Dim2, Range};
+use pcdc_mesh::{builders, split_nodes, Dim2, Range};
 
 const E: f64 = 30e9;
 
@@ -37,8 +37,6 @@ fn scene_with(cells_x: usize, backend: Backend, contact: bool) -> Simulation<Dim
     let h = 0.05 / cells_x as f64;
     let mesh = builders::rectangle(0.0, 0.0, 0.05, 0.10, h).unwrap();
     let split = split_nodes(&mesh, &Range::All).unwrap();
-    let bond_elements = split.joints.elements.clone();
-    let bond_faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
     let czm = IntrinsicCzmParams {
         friction_deg: 30.0,
         cohesion: 10e6,
@@ -53,14 +51,14 @@ fn scene_with(cells_x: usize, backend: Backend, contact: bool) -> Simulation<Dim
     .unwrap();
     let rock = LinearElastic::new(E, 0.25, 2600.0).unwrap();
     let c_p = ((rock.lambda() + 2.0 * rock.shear()) / 2600.0).sqrt();
-    let mut b = Simulation::builder(split.mesh, backend)
+    let mut b = Simulation::builder(split, backend)
         .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new(split.joints).model(Range::All, czm));
+        .physics(CohesiveJoints::new().model(Range::All, czm));
     if contact {
         b = b.physics(
             Contact::new(10.0 * E)
                 .friction(30.0, 10.0 * E)
-                .bonded_pairs(&bond_elements, &bond_faces, pcdc_cohesive::BROKEN_FACE),
+                .bonded_interfaces(pcdc_cohesive::BROKEN_FACE),
         );
     }
     b.physics(

@@ -9,11 +9,11 @@
 //! F/λ. Before the friction law was made dimensionally consistent (τ = P_t δ_s / h,
 //! manual eq. 59 corrected), the mm run slid differently from the SI run.
 
-use pcdc::cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE, JOINT_DAMAGE};
+use pcdc::cohesive::{CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE, JOINT_DAMAGE};
 use pcdc::compute::{Backend, Simulation};
 use pcdc::contact::Contact;
 use pcdc::mech::{Boundary, LinearElastic, Mechanics};
-use pcdc::mesh::{builders, Dim, Range};
+use pcdc::mesh::{builders, split_nodes, Dim, Range};
 
 /// A unit system: length (m), force (N) and time (s) units.
 #[derive(Clone, Copy, Debug)]
@@ -92,10 +92,9 @@ fn run_perturbed(scale: f64, u: Units, steps: u64, eps: f64) -> Outcome {
     }
     .build()
     .unwrap();
-    let faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * e)
         .friction(30.0, 10.0 * e)
-        .bonded_pairs(&split.joints.elements, &faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     // The base below its top face and the wall behind its front face are held.
     let fixed = Range::rect(len(-1.0), len(-1.0), len(1.0), len(0.0199)).or(Range::rect(
         len(0.2001),
@@ -103,9 +102,9 @@ fn run_perturbed(scale: f64, u: Units, steps: u64, eps: f64) -> Outcome {
         len(1.0),
         len(1.0),
     ));
-    let mut sim = Simulation::builder(split.mesh, Backend::cpu(1).unwrap())
+    let mut sim = Simulation::builder(split, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
+        .physics(CohesiveJoints::new().model(Range::All, czm))
         .physics(contact)
         .physics(Boundary::new().fix(fixed))
         .gravity([0.0, -9.81 / u.acceleration(), 0.0])
@@ -242,14 +241,13 @@ fn run_3d(u: Units, steps: u64, eps: f64) -> Outcome {
     }
     .build()
     .unwrap();
-    let faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * e)
         .friction(30.0, 10.0 * e)
-        .bonded_pairs(&split.joints.elements, &faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     let fixed = Range::cuboid([len(-1.0); 3], [len(1.0), len(1.0), len(0.0199)]);
-    let mut sim = Simulation::builder(split.mesh, Backend::cpu(1).unwrap())
+    let mut sim = Simulation::builder(split, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
+        .physics(CohesiveJoints::new().model(Range::All, czm))
         .physics(contact)
         .physics(Boundary::new().fix(fixed))
         .gravity([0.0, 0.0, -9.81 / u.acceleration()])

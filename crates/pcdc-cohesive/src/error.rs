@@ -1,6 +1,6 @@
 //! Errors of the cohesive crate.
 
-/// Errors raised by joint models and node splitting.
+/// Errors raised by joint models and fracture mapping.
 #[derive(Debug, thiserror::Error)]
 #[allow(missing_docs)] // fields are named after what they hold; variants are documented
 pub enum CohesiveError {

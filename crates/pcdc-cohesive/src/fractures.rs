@@ -11,7 +11,7 @@
 use pcdc_mesh::{Dim, Mesh};
 use serde::{Deserialize, Serialize};
 
-use crate::{CohesiveError, Joints};
+use crate::CohesiveError;
 
 /// A planar fracture.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -216,10 +216,10 @@ impl FractureNetwork {
     }
 }
 
-/// Indices of the joints lying on any of the fractures (ascending, unique).
+/// Indices of the joints (the mesh's [`pcdc_mesh::Interfaces`]) lying on any of the
+/// fractures (ascending, unique).
 pub fn joints_on_fractures<D: Dim>(
     mesh: &Mesh<D>,
-    joints: &Joints,
     fractures: &[Fracture],
 ) -> Result<Vec<u32>, CohesiveError> {
     let d = D::D;
@@ -248,8 +248,9 @@ pub fn joints_on_fractures<D: Dim>(
     let mut out = Vec::new();
     let mut c = [0.0; 3];
     let mut n = [0.0; 3];
+    let joints = mesh.interfaces();
     for j in 0..joints.len() {
-        let fa = joints.faces[2 * j] as usize;
+        let fa = joints.faces()[2 * j] as usize;
         mesh.face_centroid(fa, &mut c[..d]);
         let size = mesh.face_measure_normal(fa, &mut n[..d]);
         let half = 0.3 * if d == 2 { size } else { (2.0 * size).sqrt() };
@@ -288,16 +289,14 @@ pub fn joints_on_fractures<D: Dim>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::split_nodes;
-    use pcdc_mesh::{builders, Dim2, Dim3, Range};
+    use pcdc_mesh::{builders, split_nodes, Dim2, Dim3, Range};
 
     #[test]
     fn horizontal_fracture_maps_to_one_row_of_faces() {
         let m = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.1).unwrap();
         let s = split_nodes(&m, &Range::All).unwrap();
         let sel = joints_on_fractures(
-            &s.mesh,
-            &s.joints,
+            &s,
             &[Fracture::Segment {
                 a: [0.0, 0.5],
                 b: [1.0, 0.5],
@@ -307,14 +306,12 @@ mod tests {
         assert_eq!(sel.len(), 10);
         let mut c = [0.0; 2];
         for &j in &sel {
-            s.mesh
-                .face_centroid(s.joints.faces[2 * j as usize] as usize, &mut c);
+            s.face_centroid(s.interfaces().faces()[2 * j as usize] as usize, &mut c);
             assert!((c[1] - 0.5).abs() < 1e-12);
         }
         // A short fracture maps to fewer faces.
         let short = joints_on_fractures(
-            &s.mesh,
-            &s.joints,
+            &s,
             &[Fracture::Segment {
                 a: [0.2, 0.5],
                 b: [0.5, 0.5],
@@ -329,8 +326,7 @@ mod tests {
         let m = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.05).unwrap();
         let s = split_nodes(&m, &Range::All).unwrap();
         let sel = joints_on_fractures(
-            &s.mesh,
-            &s.joints,
+            &s,
             &[Fracture::Segment {
                 a: [0.1, 0.2],
                 b: [0.9, 0.6],
@@ -343,8 +339,8 @@ mod tests {
         let mut n = [0.0; 2];
         let (ux, uy) = (0.8 / 0.8f64.hypot(0.4), 0.4 / 0.8f64.hypot(0.4));
         for &j in &sel {
-            let f = s.joints.faces[2 * j as usize] as usize;
-            let len = s.mesh.face_measure_normal(f, &mut n);
+            let f = s.interfaces().faces()[2 * j as usize] as usize;
+            let len = s.face_measure_normal(f, &mut n);
             covered += len * (n[0] * uy - n[1] * ux).abs();
         }
         assert!(covered >= 0.8 * 0.8f64.hypot(0.4), "covered {covered}");
@@ -355,8 +351,7 @@ mod tests {
         let m = builders::cuboid([0.0; 3], [1.0, 1.0, 1.0], 0.25).unwrap();
         let s = split_nodes(&m, &Range::All).unwrap();
         let sel = joints_on_fractures(
-            &s.mesh,
-            &s.joints,
+            &s,
             &[Fracture::Disc {
                 center: [0.5, 0.5, 0.5],
                 normal: [0.0, 0.0, 1.0],
@@ -367,8 +362,7 @@ mod tests {
         // The z = 0.5 plane: 4 x 4 cells, 2 triangles each.
         assert_eq!(sel.len(), 32);
         assert!(joints_on_fractures(
-            &s.mesh,
-            &s.joints,
+            &s,
             &[Fracture::Segment {
                 a: [0.0; 2],
                 b: [1.0, 0.0]

@@ -8,9 +8,12 @@
 //! together) and the shear magnitude τ (against the slip); side A receives
 //! `w A N_k (σ n + τ s/|s|)` and side B the opposite (exact action-reaction).
 //!
-//! Fields: `joint_state` (model history per Gauss point), `joint_damage` (largest D per
-//! joint, for output), and `broken_face` (1 on both faces of a fully broken joint, on
-//! the split mesh's faces: the field contact picks up).
+//! Fields ([`crate::fields`]): `joint_state` (model history per Gauss point),
+//! `joint_damage` (largest D per joint, for output), `broken_face` (1 on both faces of a
+//! fully broken joint, on the split mesh's faces: the field contact picks up), and per
+//! joint the kinematics other physics read: `joint_opening` (δ̄·n at the face centroid),
+//! `joint_sliding` (δ̄ − (δ̄·n) n, D components) and `joint_normal` (n), written by the
+//! same kernel, for broken joints too.
 //!
 //! A broken joint (largest damage 1) transfers no force from the next step on, whatever
 //! its model: its faces interact through contact alone. Integrating it further would
@@ -25,30 +28,41 @@
 use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
-use pcdc_compute::{Components, FieldKey, FieldUse, Place};
 use pcdc_compute::{
     ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
     StableStep,
 };
 use pcdc_compute::{Entity, EntityKind};
-use pcdc_mesh::{Dim, Mesh, Range};
+use pcdc_compute::{FieldKey, FieldUse};
+use pcdc_mesh::{Dim, Interfaces, Mesh, Range};
 use rayon::prelude::*;
 
-use crate::{JointModel, Joints};
+use crate::fields::{
+    BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
+};
+use crate::JointModel;
 
 const JOINT_KERNEL: &str = include_str!("shaders/joints.wgsl");
 const JOINT_LIBRARY: &str = include_str!("shaders/joint_library.wgsl");
 
-/// Name of the joint history field.
-pub const JOINT_STATE: FieldKey =
-    FieldKey::new("joint_state", Place::Entities, Components::Declared);
-/// Name of the per-joint damage field (largest D over the Gauss points).
-pub const JOINT_DAMAGE: FieldKey =
-    FieldKey::new("joint_damage", Place::Entities, Components::Fixed(1));
-/// Name of the face field flagging the faces of broken joints (1 = broken).
-pub const BROKEN_FACE: FieldKey = FieldKey::new("broken_face", Place::Face, Components::Fixed(1));
-
 const CHUNK: usize = 256;
+
+/// Declares a per-joint field this physics owns: one value set per joint (interface) of
+/// the mesh, `components` values each (`None`: the key's). The one place to change when
+/// joints become a named entity set.
+fn own_per_joint<D: Dim>(key: FieldKey, n_joints: usize, components: Option<usize>) -> FieldUse {
+    key.own_sized::<D>(Some(n_joints), components)
+}
+
+/// Where [`CohesiveJoints::joint`] writes joint `j`'s published kinematics.
+struct JointOut<'a> {
+    /// Normal opening (m).
+    opening: &'a mut f64,
+    /// Sliding vector (m), D components.
+    sliding: &'a mut [f64],
+    /// Unit normal, D components.
+    normal: &'a mut [f64],
+}
 
 /// Gauss points on a joint face: (shape function values, weight as a fraction of the
 /// face measure).
@@ -89,10 +103,13 @@ fn gauss_rule(d: usize, points: usize) -> Vec<([f64; 3], f64)> {
     }
 }
 
-/// Face-joints with their constitutive models, as a physics.
+/// Face-joints with their constitutive models, as a physics: one joint on every
+/// interface of the mesh ([`pcdc_mesh::Mesh::interfaces`], made by
+/// [`pcdc_mesh::split_nodes`]), in the interfaces' order.
 #[derive(Debug)]
 pub struct CohesiveJoints {
-    joints: Joints,
+    /// The mesh's interfaces (copied at init).
+    joints: Interfaces,
     assignments: Vec<(Range, Arc<dyn JointModel>)>,
     /// Assignments by joint index: (index into `assignments`, joints).
     explicit: Vec<(usize, Vec<u32>)>,
@@ -102,15 +119,22 @@ pub struct CohesiveJoints {
     h: Vec<f64>,
     rule: Vec<([f64; 3], f64)>,
     n_state: usize,
-    ids: Option<[FieldId; 3]>,
+    ids: Option<[FieldId; 6]>,
+}
+
+impl Default for CohesiveJoints {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 impl CohesiveJoints {
-    /// Joints of a split mesh (see [`crate::split_nodes`]); assign models with
-    /// [`CohesiveJoints::model`].
-    pub fn new(joints: Joints) -> Self {
+    /// Joints on the interfaces of the simulation's mesh (split with
+    /// [`pcdc_mesh::split_nodes`]; a mesh without interfaces has no joints); assign
+    /// models with [`CohesiveJoints::model`].
+    pub fn new() -> Self {
         CohesiveJoints {
-            joints,
+            joints: Interfaces::default(),
             assignments: Vec::new(),
             explicit: Vec::new(),
             gauss_3d: 3,
@@ -145,11 +169,6 @@ impl CohesiveJoints {
         self
     }
 
-    /// The joints.
-    pub fn joints(&self) -> &Joints {
-        &self.joints
-    }
-
     /// History variables per Gauss point: the largest of the assigned models (≥ 1).
     fn assigned_state_len(&self) -> usize {
         self.assignments
@@ -164,16 +183,20 @@ impl CohesiveJoints {
         self.rule.len() * self.n_state
     }
 
-    /// Joint `j`'s forces into `slots` (2·NPF·D values) and its state update.
+    /// Joint `j`'s opening, sliding and normal into `out` and, unless it is `broken`
+    /// (then its slots are zeroed and its damage returned unchanged as `None`), its
+    /// forces into `slots` (2·NPF·D values), its state update and its damage.
     fn joint<D: Dim>(
         &self,
         j: usize,
         kin: &Kinematics<'_, D>,
         slots: &mut [f64],
         state: &mut [f64],
-    ) -> f64 {
+        out: JointOut<'_>,
+        broken: bool,
+    ) -> Option<f64> {
         let (d, npf) = (D::D, D::NODES_PER_FACE);
-        let nodes = &self.joints.nodes[j * 2 * npf..(j + 1) * 2 * npf];
+        let nodes = self.joints.joint_nodes(j);
         let mut mid = [0.0; 9];
         let mut gap = [0.0; 9];
         for k in 0..npf {
@@ -188,7 +211,29 @@ impl CohesiveJoints {
         }
         let mut n = [0.0; 3];
         let area = D::face_measure_normal(&mid[..npf * d], &mut n[..d]);
+        // Published kinematics: the gap at the face centroid (mean of the node-pair
+        // gaps) split along the normal.
+        let mut g = [0.0; 3];
+        for k in 0..npf {
+            for c in 0..d {
+                g[c] += gap[k * d + c];
+            }
+        }
+        let mut o = 0.0;
+        for c in 0..d {
+            g[c] /= npf as f64;
+            o += g[c] * n[c];
+        }
+        *out.opening = o;
+        for c in 0..d {
+            out.sliding[c] = g[c] - o * n[c];
+            out.normal[c] = n[c];
+        }
         slots.fill(0.0);
+        if broken {
+            // No force: contact alone acts between its faces.
+            return None;
+        }
         let model = &self.models[self.model_of[j] as usize];
         let ns = self.n_state;
         let mut damage = 0.0f64;
@@ -219,7 +264,7 @@ impl CohesiveJoints {
                 }
             }
         }
-        damage
+        Some(damage)
     }
 }
 
@@ -233,29 +278,34 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         // joint and the integration rule.
         let model_of: Vec<u32> = self.model_of.iter().map(|&m| u32::from(m)).collect();
         Fingerprint::new()
-            .u32s(&self.joints.nodes)
-            .u32s(&self.joints.elements)
-            .u32s(&self.joints.faces)
+            .u32s(self.joints.nodes())
+            .u32s(self.joints.elements())
+            .u32s(self.joints.faces())
             .debug(&self.models)
             .u32s(&model_of)
             .u64(self.gauss_3d as u64)
             .finish()
     }
 
-    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
+    fn fields(&self, mesh: &Mesh<D>) -> Vec<FieldUse> {
         let points = if D::D == 2 { 3 } else { self.gauss_3d };
         let ns = self.assigned_state_len();
-        let nj = self.joints.len();
+        let nj = mesh.interfaces().len();
         vec![
-            JOINT_STATE.own_sized::<D>(Some(nj), Some(points * ns)),
-            JOINT_DAMAGE.own_sized::<D>(Some(nj), None),
+            own_per_joint::<D>(JOINT_STATE, nj, Some(points * ns)),
+            own_per_joint::<D>(JOINT_DAMAGE, nj, None),
             BROKEN_FACE.own::<D>(),
+            own_per_joint::<D>(JOINT_OPENING, nj, None),
+            own_per_joint::<D>(JOINT_SLIDING, nj, None),
+            own_per_joint::<D>(JOINT_NORMAL, nj, None),
         ]
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let mesh = ctx.mesh;
+        // The mesh checked its interfaces against itself when it was built or read.
+        self.joints = mesh.interfaces().clone();
         let nj = self.joints.len();
         let err = |m: String| ComputeError::physics("cohesive joints", m);
         if D::D == 3 && self.gauss_3d != 3 && self.gauss_3d != 7 {
@@ -264,22 +314,6 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                 self.gauss_3d,
                 "must be 3 or 7",
             ));
-        }
-        if self.joints.nodes.len() != nj * 2 * npf || self.joints.faces.len() != 2 * nj {
-            return Err(err(format!(
-                "joint arrays do not fit {} joints of {} nodes per side",
-                nj, npf
-            )));
-        }
-        if let Some(&bad) = self
-            .joints
-            .nodes
-            .iter()
-            .find(|&&n| n as usize >= mesh.n_nodes())
-        {
-            return Err(err(format!(
-                "joint node {bad} is not a node of the mesh (was the mesh split with split_nodes?)"
-            )));
         }
         if nj > 0 && self.assignments.is_empty() {
             return Err(err(
@@ -301,7 +335,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let mut mid = vec![0.0; d];
         for j in 0..nj {
             mid.fill(0.0);
-            for &n in &self.joints.nodes[j * 2 * npf..j * 2 * npf + npf] {
+            for &n in &self.joints.joint_nodes(j)[..npf] {
                 for c in 0..d {
                     mid[c] += mesh.node(n as usize)[c] / npf as f64;
                 }
@@ -341,8 +375,8 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         };
         self.h = (0..nj)
             .map(|j| {
-                0.5 * (mean_edge(self.joints.elements[2 * j] as usize)
-                    + mean_edge(self.joints.elements[2 * j + 1] as usize))
+                0.5 * (mean_edge(self.joints.elements()[2 * j] as usize)
+                    + mean_edge(self.joints.elements()[2 * j + 1] as usize))
             })
             .collect();
         let state = ctx.fields.id(JOINT_STATE)?;
@@ -350,6 +384,9 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
             state,
             ctx.fields.id(JOINT_DAMAGE)?,
             ctx.fields.id(BROKEN_FACE)?,
+            ctx.fields.id(JOINT_OPENING)?,
+            ctx.fields.id(JOINT_SLIDING)?,
+            ctx.fields.id(JOINT_NORMAL)?,
         ];
         let stride = self.state_stride();
         let st = ctx.fields.get_mut(state);
@@ -361,7 +398,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
             }
         }
         self.ids = Some(ids);
-        ctx.register_slots(&self.joints.nodes)?;
+        ctx.register_slots(self.joints.nodes())?;
         Ok(())
     }
 
@@ -371,7 +408,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let mut mid = [0.0; 9];
         let mut n = [0.0; 3];
         for j in 0..self.joints.len() {
-            let nodes = &self.joints.nodes[j * 2 * npf..(j + 1) * 2 * npf];
+            let nodes = self.joints.joint_nodes(j);
             for k in 0..npf {
                 mid[k * D::D..(k + 1) * D::D].copy_from_slice(kin.mesh.node(nodes[k] as usize));
             }
@@ -402,36 +439,50 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
     }
 
     fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
-        let [sid, did, bid] = self.ids.expect("init ran");
+        let [sid, did, bid, oid, lid, nid] = self.ids.expect("init ran");
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let stride = self.state_stride();
         let kin = &ctx.kin;
-        let [state, damage] = ctx.fields.get_many_mut([sid, did]);
+        let [state, damage, opening, sliding, normal] =
+            ctx.fields.get_many_mut([sid, did, oid, lid, nid]);
         let slots = &mut *ctx.slots;
         ctx.backend.install(|| {
             slots
                 .par_chunks_mut(CHUNK * 2 * npf * d)
                 .zip(state.par_chunks_mut(CHUNK * stride))
                 .zip(damage.par_chunks_mut(CHUNK))
+                .zip(opening.par_chunks_mut(CHUNK))
+                .zip(sliding.par_chunks_mut(CHUNK * d))
+                .zip(normal.par_chunks_mut(CHUNK * d))
                 .enumerate()
-                .for_each(|(c, ((sl, st), dm))| {
+                .for_each(|(c, (((((sl, st), dm), op), sd), nm))| {
                     for i in 0..dm.len() {
                         let j = c * CHUNK + i;
-                        let sl = &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d];
-                        if dm[i] >= 1.0 {
-                            // Broken: no force; contact alone acts between its faces.
-                            sl.fill(0.0);
-                            continue;
+                        let out = JointOut {
+                            opening: &mut op[i],
+                            sliding: &mut sd[i * d..(i + 1) * d],
+                            normal: &mut nm[i * d..(i + 1) * d],
+                        };
+                        // A broken joint transfers no force; its kinematics are still
+                        // published.
+                        if let Some(dmg) = self.joint::<D>(
+                            j,
+                            kin,
+                            &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d],
+                            &mut st[i * stride..(i + 1) * stride],
+                            out,
+                            dm[i] >= 1.0,
+                        ) {
+                            dm[i] = dmg;
                         }
-                        dm[i] = self.joint::<D>(j, kin, sl, &mut st[i * stride..(i + 1) * stride]);
                     }
                 })
         });
         let [damage, broken] = ctx.fields.get_many_mut([did, bid]);
         for (j, &dmg) in damage.iter().enumerate() {
             if dmg >= 1.0 {
-                broken[self.joints.faces[2 * j] as usize] = 1.0;
-                broken[self.joints.faces[2 * j + 1] as usize] = 1.0;
+                broken[self.joints.faces()[2 * j] as usize] = 1.0;
+                broken[self.joints.faces()[2 * j + 1] as usize] = 1.0;
             }
         }
         Ok(())
@@ -484,8 +535,8 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let info_stride = 2 * npf + 4;
         let mut info = Vec::with_capacity(nj * info_stride);
         for j in 0..nj {
-            info.extend_from_slice(&self.joints.nodes[j * 2 * npf..(j + 1) * 2 * npf]);
-            info.extend_from_slice(&self.joints.faces[2 * j..2 * j + 2]);
+            info.extend_from_slice(self.joints.joint_nodes(j));
+            info.extend_from_slice(&self.joints.faces()[2 * j..2 * j + 2]);
             info.extend_from_slice(&model_info[self.model_of[j] as usize]);
         }
         let info = setup.upload("joint info", GpuData::U32(info));
@@ -518,6 +569,21 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                 Access::ReadWrite,
             )
             .bind("broken_face", setup.field(BROKEN_FACE)?, Access::ReadWrite)
+            .bind(
+                "joint_opening",
+                setup.field(JOINT_OPENING)?,
+                Access::ReadWrite,
+            )
+            .bind(
+                "joint_sliding",
+                setup.field(JOINT_SLIDING)?,
+                Access::ReadWrite,
+            )
+            .bind(
+                "joint_normal",
+                setup.field(JOINT_NORMAL)?,
+                Access::ReadWrite,
+            )
             .bind("slots", setup.slots(), Access::ReadWrite);
         setup.kernel(Phase::Forces, kernel)
     }
@@ -526,10 +592,10 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
 #[cfg(test)]
 mod gpu_tests {
     use super::*;
-    use crate::{split_nodes, IntrinsicCzm, IntrinsicCzmParams, MohrCoulombJointParams, Traction};
+    use crate::{IntrinsicCzm, IntrinsicCzmParams, MohrCoulombJointParams, Traction};
     use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
     use pcdc_compute::Precision;
-    use pcdc_mesh::builders;
+    use pcdc_mesh::{builders, split_nodes};
 
     /// A joint model without a WGSL body (CPU only).
     #[derive(Debug)]
@@ -569,7 +635,7 @@ mod gpu_tests {
 
     /// Both built-in models (CZM everywhere, Mohr-Coulomb on one half, a second CZM
     /// with other parameters that shares the first one's WGSL function).
-    fn joints(j: Joints, gauss_3d: usize) -> CohesiveJoints {
+    fn joints(gauss_3d: usize) -> CohesiveJoints {
         let half = Range::HalfSpace {
             point: [0.5, 0.0, 0.0],
             normal: [1.0, 0.0, 0.0],
@@ -586,7 +652,7 @@ mod gpu_tests {
         }
         .build()
         .unwrap();
-        CohesiveJoints::new(j)
+        CohesiveJoints::new()
             .model(Range::All, czm())
             .model(
                 half,
@@ -610,22 +676,10 @@ mod gpu_tests {
         let s2 = split_nodes(&m2, &Range::All).unwrap();
         let s3 = split_nodes(&m3, &Range::All).unwrap();
         for p in [Precision::F64, Precision::F32] {
-            let k2 = offline_kernel_sources::<_>(
-                &s2.mesh,
-                vec![Box::new(joints(s2.joints.clone(), 3))],
-                p,
-            )
-            .unwrap();
+            let k2 = offline_kernel_sources::<_>(&s2, vec![Box::new(joints(3))], p).unwrap();
             let mut all = k2.clone();
             for g in [3, 7] {
-                all.extend(
-                    offline_kernel_sources::<_>(
-                        &s3.mesh,
-                        vec![Box::new(joints(s3.joints.clone(), g))],
-                        p,
-                    )
-                    .unwrap(),
-                );
+                all.extend(offline_kernel_sources::<_>(&s3, vec![Box::new(joints(g))], p).unwrap());
             }
             let joint_kernels: Vec<_> = all
                 .iter()
@@ -646,7 +700,7 @@ mod gpu_tests {
     #[test]
     fn no_joints_no_kernel() {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
-        let j = CohesiveJoints::new(Joints::default());
+        let j = CohesiveJoints::new();
         let k = offline_kernel_sources::<_>(&m2, vec![Box::new(j)], Precision::F64).unwrap();
         assert!(k.iter().all(|(l, _)| !l.starts_with("cohesive joints")));
     }
@@ -655,11 +709,10 @@ mod gpu_tests {
     fn joint_model_without_wgsl_is_a_build_error_naming_it() {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
         let s2 = split_nodes(&m2, &Range::All).unwrap();
-        let j = CohesiveJoints::new(s2.joints)
+        let j = CohesiveJoints::new()
             .model(Range::All, czm())
             .model_for(vec![0], CpuOnly);
-        let err =
-            offline_kernel_sources::<_>(&s2.mesh, vec![Box::new(j)], Precision::F64).unwrap_err();
+        let err = offline_kernel_sources::<_>(&s2, vec![Box::new(j)], Precision::F64).unwrap_err();
         assert!(matches!(err, ComputeError::NoGpuKernel { .. }), "{err:?}");
         let msg = err.to_string();
         assert!(

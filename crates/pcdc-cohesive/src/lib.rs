@@ -4,15 +4,18 @@
 //! [`JointModel`] plugin trait, starting with the intrinsic cohesive zone model
 //! [`IntrinsicCzm`] (eq. 63-73: penalties, peak opening and slip, damage D, softening
 //! f(D) with A = 0.63, B = 1.8, C = 6.0, Mohr-Coulomb shear strength, unloading along
-//! the secant, softening lengths from G_f1 and G_f2), and node splitting
-//! ([`split_nodes`]) that gives the elements of FDEM regions their own nodes and puts a
-//! face-joint on every interior face.
+//! the secant, softening lengths from G_f1 and G_f2), integrated over the face-joints of
+//! a mesh split by [`pcdc_mesh::split_nodes`] (the mesh carries them as its
+//! [`pcdc_mesh::Interfaces`], which every physics reads).
 //!
 //! The joint models ([`IntrinsicCzm`], [`MohrCoulombJoint`]) are built from parameter
 //! structs with named fields ([`IntrinsicCzmParams`], [`MohrCoulombJointParams`]) and
 //! are immutable afterwards (read accessors only); building and deserialisation share
 //! one check, so a model read from a file is validated and its cached derived constants
 //! are always built from the parameters it holds.
+//!
+//! [`CohesiveJoints`] publishes per joint, for other physics to read, the normal opening,
+//! the sliding vector and the unit normal ([`fields`]), computed with the joint forces.
 //!
 //! Joints run on both backends: [`CohesiveJoints`] has a GPU kernel into which each
 //! model's WGSL body ([`JointModel::wgsl`], [`WgslJointModel`]) is spliced; the built-in
@@ -24,17 +27,19 @@
 #![allow(clippy::needless_range_loop)]
 
 mod error;
+pub mod fields;
 pub mod fractures;
 mod joints;
 mod model;
-mod split;
 
 pub use error::CohesiveError;
+pub use fields::{
+    BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
+};
 pub use fractures::{joints_on_fractures, Distribution, Fracture, FractureNetwork};
-pub use joints::{CohesiveJoints, BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE};
+pub use joints::CohesiveJoints;
 pub use model::{
     czm_state, portable_exp, softening, softening_integral, FailureMode, IntrinsicCzm,
     IntrinsicCzmParams, JointModel, MohrCoulombJoint, MohrCoulombJointParams, Traction,
     WgslJointModel, SOFTENING_A, SOFTENING_B, SOFTENING_C,
 };
-pub use split::{split_nodes, Joints, SplitMesh};

@@ -12,7 +12,10 @@
 //! P_open/h so that the normal traction is smooth at zero opening.
 //!
 //! Measured, and compared: displacement (f64: max |Δu| / max |u| ≤ 1e-12), joint damage
-//! (absolute), joint history, broken faces (f64: identical). Fracture is an unstable
+//! (absolute), joint history, broken faces (f64: identical), and the joint kinematics
+//! published for other physics, read back from the device like every field: opening and
+//! sliding (a gap is a difference of positions, so f64 asks them within 4 × the
+//! displacement bar × max |u|) and the unit normal (within that over the cell size). Fracture is an unstable
 //! process that amplifies any rounding difference, so every test also runs the CPU a
 //! second time with its initial velocities perturbed by 1e-15 (relative) and prints how
 //! far that run drifts: the GPU difference is of the same size, the conditioning of the
@@ -23,13 +26,13 @@
 //! skip (and fail with PCDC_REQUIRE_GPU=1).
 
 use pcdc_cohesive::{
-    joints_on_fractures, split_nodes, CohesiveJoints, Fracture, IntrinsicCzmParams,
-    MohrCoulombJointParams, BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE,
+    joints_on_fractures, CohesiveJoints, Fracture, IntrinsicCzmParams, MohrCoulombJointParams,
+    BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
 };
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_mech::{LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh, Range};
+use pcdc_mesh::{builders, split_nodes, Dim, Dim2, Dim3, Mesh, Range};
 
 const E: f64 = 30e9;
 /// Cell size of the bars (m).
@@ -84,12 +87,16 @@ fn slide(fracture: Fracture) -> Scene {
     }
 }
 
-/// What a run leaves: displacement, joint damage, broken faces, joint history.
+/// What a run leaves: displacement, joint damage, broken faces, joint history, joint
+/// opening, sliding and normal.
 struct Outcome {
     u: Vec<f64>,
     damage: Vec<f64>,
     broken: Vec<f64>,
     state: Vec<f64>,
+    opening: Vec<f64>,
+    sliding: Vec<f64>,
+    normal: Vec<f64>,
 }
 
 /// The scene body, generic over the backend.
@@ -141,12 +148,12 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
     }
     .build()
     .unwrap();
-    let mut joints = CohesiveJoints::new(split.joints.clone())
+    let mut joints = CohesiveJoints::new()
         .model(Range::All, strong)
         .model(band, weak)
         .gauss_points_3d(s.gauss_3d);
     if let Some(f) = s.fracture.clone() {
-        let on = joints_on_fractures(&split.mesh, &split.joints, &[f]).unwrap();
+        let on = joints_on_fractures(&split, &[f]).unwrap();
         assert!(!on.is_empty());
         joints = joints.model_for(
             on,
@@ -164,7 +171,7 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
         .unwrap()
         .with_damping(0.1)
         .unwrap();
-    let mut sim = Simulation::builder(split.mesh.clone(), backend)
+    let mut sim = Simulation::builder(split.clone(), backend)
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(joints)
         .build()
@@ -175,7 +182,7 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
     let x = sim.mesh().coords().to_vec();
     let mid = 0.5 * (lo[axis] + hi[axis]);
     for n in 0..sim.mesh().n_nodes() {
-        let m = split.master[n] as usize;
+        let m = split.interfaces().master()[n] as usize;
         let xi = (x[n * d + axis] - mid) / (0.5 * len);
         sim.state.v[n * d + axis] = s.pull * xi * (1.0 + 0.05 * noise(m * d + axis));
         sim.state.v[n * d] += s.shear * xi * (1.0 + 0.05 * noise(m * d));
@@ -191,6 +198,9 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
         damage: sim.field(JOINT_DAMAGE).unwrap().to_vec(),
         broken: sim.field(BROKEN_FACE).unwrap().to_vec(),
         state: sim.field(JOINT_STATE).unwrap().to_vec(),
+        opening: sim.field(JOINT_OPENING).unwrap().to_vec(),
+        sliding: sim.field(JOINT_SLIDING).unwrap().to_vec(),
+        normal: sim.field(JOINT_NORMAL).unwrap().to_vec(),
     }
 }
 
@@ -242,16 +252,29 @@ fn parity<D: Dim>(name: &str, mesh: Mesh<D>, scene: Scene, precision: Precision,
         .zip(&dev.broken)
         .filter(|(a, b)| a != b)
         .count();
+    let d_open = max_diff(&cpu.opening, &dev.opening);
+    let d_slide = max_diff(&cpu.sliding, &dev.sliding);
+    let d_normal = max_diff(&cpu.normal, &dev.normal);
     println!(
         "{name} {} {} on {}, {} steps: {n} joints ({softening} softening, {broken} broken, \
          {faces} broken faces); max relative difference displacement {du:.3e} (CPU with \
          1e-15 perturbed start: {dp:.3e}), joint damage (absolute) {dd:.3e}, joint state \
-         (relative to max) {ds:.3e}, broken faces that differ {flips}",
+         (relative to max) {ds:.3e}, broken faces that differ {flips}; joint opening \
+         {d_open:.3e} m (max {:.3e} m), sliding {d_slide:.3e} m (max {:.3e} m), normal \
+         {d_normal:.3e}",
         D::NAME,
         precision.name(),
         gpu.as_gpu().expect("a GPU backend").adapter_name(),
-        scene.steps
+        scene.steps,
+        max_abs(&cpu.opening),
+        max_abs(&cpu.sliding),
     );
+    // The kinematics came back from the device: open joints, unit normals.
+    assert!(max_abs(&dev.opening) > 0.0 && max_abs(&dev.sliding) > 0.0);
+    for n in dev.normal.chunks_exact(D::D) {
+        let len = n.iter().map(|x| x * x).sum::<f64>().sqrt();
+        assert!((len - 1.0).abs() < 1e-5, "normal {n:?}");
+    }
     assert!(softening > 0, "no joint is softening");
     assert!(broken > 0, "no joint broke");
     if precision == Precision::F64 {
@@ -260,6 +283,20 @@ fn parity<D: Dim>(name: &str, mesh: Mesh<D>, scene: Scene, precision: Precision,
         assert!(dd <= 1e-10, "joint damage differs by {dd:e}");
         assert!(ds <= 1e-10, "joint state differs by {ds:e}");
         assert_eq!(flips, 0, "broken faces differ");
+        let gap_bar = 4.0 * bar * scale;
+        assert!(
+            d_open <= gap_bar,
+            "opening differs by {d_open:e} m (> {gap_bar:e})"
+        );
+        assert!(
+            d_slide <= gap_bar,
+            "sliding differs by {d_slide:e} m (> {gap_bar:e})"
+        );
+        let normal_bar = gap_bar / CELL;
+        assert!(
+            d_normal <= normal_bar,
+            "normal differs by {d_normal:e} (> {normal_bar:e})"
+        );
     } else {
         assert!(du <= tol, "displacement differs by {du:e} (> {tol:e})");
         assert!(dd <= 0.05, "joint damage differs by {dd:e}");
@@ -355,7 +392,8 @@ fn joint_forces_agree_to_rounding() {
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    fn forces(backend: Backend, amp: f64) -> (Vec<f64>, Vec<f64>) {
+    /// Forces, damage, and opening, sliding and normal side by side.
+    fn forces(backend: Backend, amp: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
         let split = split_nodes(&bar_2d(), &Range::All).unwrap();
         let czm = IntrinsicCzmParams {
             friction_deg: 30.0,
@@ -370,21 +408,25 @@ fn joint_forces_agree_to_rounding() {
         .build()
         .unwrap();
         let soft = LinearElastic::new(1.0, 0.25, 2600.0).unwrap();
-        let mut sim = Simulation::builder(split.mesh, backend)
+        let mut sim = Simulation::builder(split, backend)
             .physics(Mechanics::new().material(Range::All, soft))
-            .physics(CohesiveJoints::new(split.joints).model(Range::All, czm))
+            .physics(CohesiveJoints::new().model(Range::All, czm))
             .build()
             .unwrap();
         for (i, u) in sim.state.u.iter_mut().enumerate() {
             *u = amp * noise(i);
         }
         let f = sim.evaluate_forces().unwrap().to_vec();
-        (f, sim.field(JOINT_DAMAGE).unwrap().to_vec())
+        let kin = [JOINT_OPENING, JOINT_SLIDING, JOINT_NORMAL]
+            .iter()
+            .flat_map(|name| sim.field(name).unwrap().to_vec())
+            .collect();
+        (f, sim.field(JOINT_DAMAGE).unwrap().to_vec(), kin)
     }
     // From pre-peak (1e-9 m) to broken (1e-6 m) openings.
     for amp in [1e-9, 1e-8, 1e-7, 1e-6] {
-        let (a, da) = forces(Backend::cpu(1).unwrap(), amp);
-        let (b, db) = forces(gpu.clone(), amp);
+        let (a, da, ka) = forces(Backend::cpu(1).unwrap(), amp);
+        let (b, db, kb) = forces(gpu.clone(), amp);
         let exact = a.iter().zip(&b).filter(|(x, y)| x == y).count();
         let rel = max_diff(&a, &b) / max_abs(&a);
         let dd = max_diff(&da, &db);
@@ -396,5 +438,23 @@ fn joint_forces_agree_to_rounding() {
         );
         assert!(rel <= 1e-15, "forces differ by {rel:e}");
         assert!(dd <= 1e-14, "damage differs by {dd:e}");
+        // Opening, sliding (m) and normal: the gaps carry the rounding of positions
+        // (coordinates up to 0.04 m: 7e-18 m per ulp), the normal that of unit vectors.
+        let nj = da.len();
+        let (dk_gap, dk_normal) = (
+            max_diff(&ka[..3 * nj], &kb[..3 * nj]),
+            max_diff(&ka[3 * nj..], &kb[3 * nj..]),
+        );
+        let exact_k = ka.iter().zip(&kb).filter(|(x, y)| x == y).count();
+        println!(
+            "  opening and sliding difference {dk_gap:.3e} m, normal {dk_normal:.3e}, \
+             {exact_k}/{} identical",
+            ka.len()
+        );
+        assert!(
+            dk_gap <= 1e-16,
+            "opening or sliding differs by {dk_gap:e} m"
+        );
+        assert!(dk_normal <= 1e-14, "normal differs by {dk_normal:e}");
     }
 }

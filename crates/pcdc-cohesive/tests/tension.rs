@@ -1,10 +1,10 @@
 //! A fully split bar pulled apart breaks when its mean stress reaches the tensile
 //! strength (2D and 3D), with results independent of the thread count.
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzm, IntrinsicCzmParams, JOINT_DAMAGE};
+use pcdc_cohesive::{CohesiveJoints, IntrinsicCzm, IntrinsicCzmParams, JOINT_DAMAGE};
 use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Dim, Mesh, Range};
+use pcdc_mesh::{builders, split_nodes, Dim, Mesh, Range};
 
 const E: f64 = 30e9;
 const TS: f64 = 2e6;
@@ -54,10 +54,10 @@ fn pull_with<D: Dim>(
         .unwrap()
         .with_damping(0.3)
         .unwrap();
-    let mut sim = Simulation::builder(split.mesh.clone(), Backend::cpu(threads).unwrap())
+    let mut sim = Simulation::builder(split.clone(), Backend::cpu(threads).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(
-            CohesiveJoints::new(split.joints.clone())
+            CohesiveJoints::new()
                 .model(Range::All, czm())
                 .gauss_points_3d(gauss_3d),
         )
@@ -175,7 +175,7 @@ fn user_joint_model_plugs_in() {
         stiffness: k,
         break_opening: 1e6 / k,
     };
-    let mut sim = Simulation::builder(split.mesh.clone(), Backend::cpu(1).unwrap())
+    let mut sim = Simulation::builder(split.clone(), Backend::cpu(1).unwrap())
         .physics(
             Mechanics::new().material(
                 Range::All,
@@ -185,7 +185,7 @@ fn user_joint_model_plugs_in() {
                     .unwrap(),
             ),
         )
-        .physics(CohesiveJoints::new(split.joints.clone()).model(Range::All, brittle))
+        .physics(CohesiveJoints::new().model(Range::All, brittle))
         .physics(
             Boundary::new()
                 .velocity(Range::group("bottom"), [None, Some(0.0.into()), None])
@@ -211,11 +211,11 @@ fn user_joint_model_plugs_in() {
 fn undamped_joints_limit_the_time_step() {
     let mesh = builders::rectangle(0.0, 0.0, 0.02, 0.04, 0.005).unwrap();
     let split = split_nodes(&mesh, &Range::All).unwrap();
-    let sim = Simulation::builder(split.mesh, Backend::cpu(1).unwrap())
+    let sim = Simulation::builder(split, Backend::cpu(1).unwrap())
         .physics(
             Mechanics::new().material(Range::All, LinearElastic::new(E, 0.25, 2600.0).unwrap()),
         )
-        .physics(CohesiveJoints::new(split.joints).model(Range::All, czm()))
+        .physics(CohesiveJoints::new().model(Range::All, czm()))
         .build()
         .unwrap();
     let limit = sim.time_step_limit().unwrap();
@@ -242,8 +242,7 @@ fn a_pre_existing_fracture_carries_no_tension() {
     let mesh = builders::rectangle(0.0, 0.0, 0.02, 0.04, 0.005).unwrap();
     let split = split_nodes(&mesh, &Range::All).unwrap();
     let on_crack = joints_on_fractures(
-        &split.mesh,
-        &split.joints,
+        &split,
         &[Fracture::Segment {
             a: [0.0, 0.02],
             b: [0.02, 0.02],
@@ -263,10 +262,10 @@ fn a_pre_existing_fracture_carries_no_tension() {
         .unwrap()
         .with_damping(0.3)
         .unwrap();
-    let mut sim = Simulation::builder(split.mesh.clone(), Backend::cpu(2).unwrap())
+    let mut sim = Simulation::builder(split.clone(), Backend::cpu(2).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(
-            CohesiveJoints::new(split.joints.clone())
+            CohesiveJoints::new()
                 .model(Range::All, czm())
                 .model_for(on_crack.clone(), fracture),
         )

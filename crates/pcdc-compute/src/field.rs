@@ -34,6 +34,19 @@ pub mod names {
     /// Owner: mechanics.
     pub const MODEL_STATE: FieldKey =
         FieldKey::new("model_state", Place::Element, Components::Declared);
+    /// Normal opening of each joint, one per interface of the split mesh in its order
+    /// (`pcdc_mesh::Mesh::interfaces`): o = δ̄·n (m), δ̄ the mean gap of the node pairs,
+    /// n the unit normal below; positive when open. Owner: cohesive joints.
+    pub const JOINT_OPENING: FieldKey =
+        FieldKey::new("joint_opening", Place::Entities, Components::Fixed(1));
+    /// Sliding of each joint: s = δ̄ − o n (m), a vector in global axes orthogonal to the
+    /// normal (|s| is the sliding distance). Owner: cohesive joints.
+    pub const JOINT_SLIDING: FieldKey =
+        FieldKey::new("joint_sliding", Place::Entities, Components::Vector);
+    /// Unit normal of each joint's midplane, from side A to side B of its interface.
+    /// Owner: cohesive joints.
+    pub const JOINT_NORMAL: FieldKey =
+        FieldKey::new("joint_normal", Place::Entities, Components::Vector);
 }
 
 /// Where a field key lives (the entity count of [`Place::Entities`] is given by the

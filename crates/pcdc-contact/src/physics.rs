@@ -16,8 +16,9 @@
 //! damping (eq. 61), the largest trial normal stress reached and the stress held there.
 //!
 //! Elements bonded by an intact cohesive joint do not contact each other once the bonds
-//! are declared with [`Contact::bonded_pairs`]; the pair becomes a contact pair as soon
-//! as the joint's broken-face flag is set (the cohesive crate publishes it).
+//! are declared, from the mesh's interfaces with [`Contact::bonded_interfaces`] or as
+//! lists with [`Contact::bonded_pairs`]; the pair becomes a contact pair as soon as the
+//! joint's broken-face flag is set (the cohesive crate publishes it).
 //!
 //! The contact law (eq. 59-61) sees per pair a trial normal stress σ_try = |F_n| / A over
 //! a contact measure A, a contact length h and a scalar slip increment:
@@ -228,6 +229,8 @@ pub struct Contact {
 /// that says when the bond is broken.
 #[derive(Clone, Debug)]
 struct Bonds {
+    /// Take the bonds from the mesh's interfaces at init (filling `elements` and `faces`).
+    from_mesh: bool,
     /// Elements of each bond, stride 2.
     elements: Vec<u32>,
     /// One face of each bond.
@@ -313,9 +316,8 @@ impl Contact {
     /// `elements` holds the two elements of each bond (stride 2), `faces` one face per bond
     /// (the bond's face on either side), and `broken_field` names a face field that is 0
     /// while the bond holds and non-zero once it is broken. For FDEM regions from
-    /// `pcdc_cohesive::split_nodes`: `joints.elements`, every other entry of
-    /// `joints.faces`, and `pcdc_cohesive::BROKEN_FACE`, so broken joint faces become
-    /// contact faces.
+    /// `pcdc_mesh::split_nodes`, [`Contact::bonded_interfaces`] says the same in one
+    /// call.
     pub fn bonded_pairs(
         mut self,
         elements: &[u32],
@@ -324,9 +326,29 @@ impl Contact {
     ) -> Self {
         let broken_field = broken_field.as_ref();
         self.bonds = Some(Bonds {
+            from_mesh: false,
             elements: elements.to_vec(),
             faces: faces.to_vec(),
             field: broken_field.to_string(),
+            id: None,
+            per_element: Vec::new(),
+        });
+        self
+    }
+
+    /// Declares the interfaces of the simulation's mesh ([`pcdc_mesh::Mesh::interfaces`],
+    /// made by [`pcdc_mesh::split_nodes`]) as bonded pairs: the two elements of each
+    /// interface do not contact each other while the face field `broken_field` is 0 on
+    /// the interface's side-A face. With `pcdc_cohesive::BROKEN_FACE` the faces of
+    /// broken cohesive joints become contact faces. The same as [`Contact::bonded_pairs`]
+    /// with the interfaces' elements and side-A faces, read from the mesh at init (a mesh
+    /// without interfaces has no bonds); it replaces an earlier bond declaration.
+    pub fn bonded_interfaces(mut self, broken_field: impl AsRef<str>) -> Self {
+        self.bonds = Some(Bonds {
+            from_mesh: true,
+            elements: Vec::new(),
+            faces: Vec::new(),
+            field: broken_field.as_ref().to_string(),
             id: None,
             per_element: Vec::new(),
         });
@@ -756,6 +778,11 @@ impl<D: Dim> Physics<D> for Contact {
             ));
         }
         if let Some(b) = &mut self.bonds {
+            if b.from_mesh {
+                let interfaces = ctx.mesh.interfaces();
+                b.elements = interfaces.elements().to_vec();
+                b.faces = interfaces.faces().iter().step_by(2).copied().collect();
+            }
             let (ne, nf) = (ctx.mesh.n_elements(), ctx.mesh.faces().len());
             if b.elements.len() % 2 != 0 || b.elements.len() / 2 != b.faces.len() {
                 return Err(ComputeError::param(

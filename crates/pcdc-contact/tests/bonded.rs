@@ -7,7 +7,7 @@ use pcdc_compute::{
 };
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
-use pcdc_mesh::{Dim2, Mesh, Range};
+use pcdc_mesh::{split_nodes, Dim2, Mesh, Range};
 
 const FLAG: FieldKey = FieldKey::new("bond_broken", Place::Face, Components::Fixed(1));
 
@@ -73,6 +73,75 @@ fn bonded_pair_has_no_contact_until_broken() {
         (push_a + push_b).abs() <= 1e-9 * push_b,
         "action = reaction: {push_a} vs {push_b}"
     );
+}
+
+/// The same two triangles made by splitting a square with shared nodes: the split mesh
+/// carries one interface between them, and `bonded_interfaces` reads the bond from it
+/// (no list, no dependency on pcdc-cohesive), bit for bit as the list would.
+#[test]
+fn the_mesh_interfaces_are_the_bonds() {
+    let square = Mesh::<Dim2>::new(
+        vec![0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        vec![0, 1, 2, 1, 3, 2],
+    )
+    .unwrap();
+    let mesh = split_nodes(&square, &Range::All).unwrap();
+    let joint = mesh.interfaces().get(0).unwrap();
+    assert_eq!(mesh.interfaces().len(), 1);
+    assert_eq!(joint.elements, [0, 1]);
+    let face = joint.faces[0];
+    let forces = |contact: Contact, broken: bool| -> Vec<f64> {
+        let rock = LinearElastic::new(1e9, 0.25, 1000.0).unwrap();
+        let mut sim = Simulation::builder(mesh.clone(), Backend::cpu(1).unwrap())
+            .physics(Mechanics::new().material(Range::All, rock))
+            .physics(BondFlags)
+            .physics(contact)
+            .build()
+            .unwrap();
+        // Element 1 (nodes 3-5 after the split) pushed into element 0.
+        assert_eq!(sim.mesh().element(1), &[3, 4, 5]);
+        for n in 3..6 {
+            sim.state.u[2 * n] = -0.05;
+            sim.state.u[2 * n + 1] = -0.05;
+        }
+        if broken {
+            let id = sim.state.fields.id(FLAG).unwrap();
+            sim.state.fields.get_mut(id)[face as usize] = 1.0;
+        }
+        sim.evaluate_forces().unwrap().to_vec()
+    };
+    for broken in [false, true] {
+        let listed = forces(
+            Contact::new(1e10).bonded_pairs(&[0, 1], &[face], FLAG),
+            broken,
+        );
+        let from_mesh = forces(Contact::new(1e10).bonded_interfaces(FLAG), broken);
+        assert!(
+            listed
+                .iter()
+                .zip(&from_mesh)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "broken {broken}: {listed:?} vs {from_mesh:?}"
+        );
+    }
+    // The bond hides the contact until it breaks.
+    assert_ne!(
+        forces(Contact::new(1e10).bonded_interfaces(FLAG), false),
+        forces(Contact::new(1e10).bonded_interfaces(FLAG), true)
+    );
+    // A mesh without interfaces declares no bonds: contact acts at once.
+    let (mut plain, _) = scene(false);
+    let f_plain = plain.evaluate_forces().unwrap().to_vec();
+    let (unsplit, _) = scene(false);
+    let rock = LinearElastic::new(1e9, 0.25, 1000.0).unwrap();
+    let mut sim = Simulation::builder(unsplit.mesh().clone(), Backend::cpu(1).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(BondFlags)
+        .physics(Contact::new(1e10).bonded_interfaces(FLAG))
+        .build()
+        .unwrap();
+    sim.state.u.copy_from_slice(&plain.state.u);
+    assert_ne!(sim.evaluate_forces().unwrap().to_vec(), f_plain);
 }
 
 #[test]

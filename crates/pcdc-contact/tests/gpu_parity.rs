@@ -18,12 +18,12 @@
 //! the drift that causes (as in the cohesive parity tests).
 //! Without a GPU adapter the tests skip (and fail with PCDC_REQUIRE_GPU=1).
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
+use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_contact::{Contact, CONTACT_REFERENCE};
 use pcdc_mech::{LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Dim2, Dim3, Mesh, Range};
+use pcdc_mesh::{builders, split_nodes, Dim2, Dim3, Mesh, Range};
 
 const E: f64 = 1e9;
 /// Impact speed of the FDEM block (m/s).
@@ -92,13 +92,12 @@ fn fdem(backend: Backend, perturb: f64) -> Outcome {
     }
     .build()
     .unwrap();
-    let joints = CohesiveJoints::new(split.joints.clone()).model(Range::All, czm);
-    let bond_faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
+    let joints = CohesiveJoints::new().model(Range::All, czm);
     let contact = Contact::new(10.0 * E)
         .friction(20.0, 10.0 * E)
-        .bonded_pairs(&split.joints.elements, &bond_faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
-    let mut sim = Simulation::builder(split.mesh.clone(), backend)
+    let mut sim = Simulation::builder(split.clone(), backend)
         .physics(Mechanics::new().material(Range::All, rock))
         .physics(joints)
         .physics(contact)

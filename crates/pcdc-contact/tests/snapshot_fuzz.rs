@@ -11,11 +11,11 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
+use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
 use pcdc_compute::{Backend, ComputeError, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Dim2, Range};
+use pcdc_mesh::{builders, split_nodes, Dim2, Range};
 
 const E: f64 = 1e9;
 
@@ -38,14 +38,13 @@ fn fdem(x_struck: f64, friction: f64) -> Simulation<Dim2> {
     }
     .build()
     .unwrap();
-    let bond_faces: Vec<u32> = split.joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * E)
         .friction(friction, 10.0 * E)
-        .bonded_pairs(&split.joints.elements, &bond_faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     let rock = LinearElastic::new(E, 0.25, 1000.0).unwrap();
-    let mut sim = Simulation::builder(split.mesh.clone(), Backend::cpu(1).unwrap())
+    let mut sim = Simulation::builder(split.clone(), Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new(split.joints.clone()).model(Range::All, czm))
+        .physics(CohesiveJoints::new().model(Range::All, czm))
         .physics(contact)
         .build()
         .unwrap();

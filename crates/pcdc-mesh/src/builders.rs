@@ -1423,10 +1423,18 @@ mod tests {
 /// Joins separate bodies into one mesh (nodes and elements concatenated in order, node
 /// indices offset), e.g. a block resting on a base for contact. Bodies keep their own
 /// nodes, so they interact only through contact. Returns the mesh and, per body, its
-/// node indices in the joined mesh; groups of the inputs are not carried over.
+/// node indices in the joined mesh; groups of the inputs are not carried over. A body
+/// that was split already ([`crate::split_nodes`]) is refused ([`MeshError::AlreadySplit`]):
+/// join first, then split, so that the union carries the interfaces.
 pub fn union<D: Dim>(bodies: &[&Mesh<D>]) -> Result<(Mesh<D>, Vec<Vec<u32>>), MeshError> {
     if bodies.is_empty() {
         return Err(MeshError::Empty);
+    }
+    if let Some(b) = bodies.iter().find(|b| b.interfaces().is_split()) {
+        return Err(MeshError::AlreadySplit {
+            interfaces: b.interfaces().len(),
+            hint: "join the bodies first, then split the union",
+        });
     }
     let (mut coords, mut conn, mut nodes) = (Vec::new(), Vec::new(), Vec::new());
     for b in bodies {

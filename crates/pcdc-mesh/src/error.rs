@@ -82,6 +82,13 @@ pub enum MeshError {
     /// The memory limit environment variable is malformed.
     #[error("environment variable PCDC_MEMORY_LIMIT = '{value}': {reason}")]
     MemoryLimitSetting { value: String, reason: &'static str },
+    /// The mesh was split already ([`crate::split_nodes`]): it cannot be split again or
+    /// joined to other bodies without losing its interfaces.
+    #[error("the mesh is already split ({interfaces} interfaces): {hint}")]
+    AlreadySplit {
+        interfaces: usize,
+        hint: &'static str,
+    },
     /// A serialised mesh is inconsistent with its own elements.
     #[error("inconsistent mesh data: {0}")]
     Inconsistent(String),

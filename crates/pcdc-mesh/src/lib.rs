@@ -3,7 +3,9 @@
 //! Struct-of-arrays meshes for the pcdc-rs FDEM SDK (manual chapter 4): dimension types
 //! ([`Dim2`], [`Dim3`]), the [`Mesh`] of Tri3 or Tet4 elements with its faces and
 //! groups, [`Range`] selections, checks on build, specimen builders, Gmsh MSH 4.1 import
-//! and VTU/PVD output for ParaView.
+//! and VTU/PVD output for ParaView; node splitting into FDEM regions ([`split_nodes`])
+//! and the [`Interfaces`] (face-joints, matched node pairs, master-node map) a split
+//! mesh carries for every physics to read.
 //!
 //! Units are SI throughout: coordinates in metres.
 //!
@@ -34,11 +36,13 @@
 
 mod dim;
 mod error;
+mod interface;
 mod mesh;
 mod range;
 
 pub use dim::{Dim, Dim2, Dim3, ElementKind};
 pub use error::MeshError;
+pub use interface::{split_nodes, Interface, Interfaces};
 pub use mesh::{Faces, Groups, Mesh, DEGENERATE_REL, MAX_COORD, NO_NEIGHBOR};
 pub use range::{PointPredicate, Range};
 

@@ -3,7 +3,7 @@
 use std::collections::{BTreeMap, HashMap};
 use std::marker::PhantomData;
 
-use crate::{Dim, MeshError, Range};
+use crate::{Dim, Interfaces, MeshError, Range};
 
 /// Marker for "no neighbouring element" in [`Faces::neighbor`].
 pub const NO_NEIGHBOR: u32 = u32::MAX;
@@ -68,7 +68,9 @@ pub struct Groups {
 /// Deserialising a mesh runs the checks of [`Mesh::new`] on its nodes and elements,
 /// rebuilds the faces and requires the stored ones to equal them (an error names the first
 /// difference), and checks every group index as [`Mesh::add_node_group`] and its siblings
-/// do: a mesh file edited by hand or corrupted is an error, never a panic later.
+/// do, and the interfaces of a split mesh as [`Mesh::interfaces`] describes them: a mesh
+/// file edited by hand or corrupted is an error, never a panic later. A mesh serialised
+/// without interfaces (written before they existed) reads as a mesh that was not split.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 #[serde(bound = "", try_from = "RawMesh")]
 pub struct Mesh<D: Dim> {
@@ -76,6 +78,7 @@ pub struct Mesh<D: Dim> {
     elements: Vec<u32>,
     faces: Faces,
     groups: Groups,
+    interfaces: Interfaces,
     #[serde(skip)]
     _dim: PhantomData<D>,
 }
@@ -87,6 +90,8 @@ struct RawMesh {
     elements: Vec<u32>,
     faces: Faces,
     groups: Groups,
+    #[serde(default)]
+    interfaces: Interfaces,
 }
 
 impl<D: Dim> TryFrom<RawMesh> for Mesh<D> {
@@ -104,6 +109,7 @@ impl<D: Dim> TryFrom<RawMesh> for Mesh<D> {
         for (name, v) in raw.groups.faces {
             mesh.add_face_group(name, v)?;
         }
+        mesh.set_interfaces(raw.interfaces)?;
         Ok(mesh)
     }
 }
@@ -244,6 +250,7 @@ impl<D: Dim> Mesh<D> {
             elements,
             faces,
             groups: Groups::default(),
+            interfaces: Interfaces::none(D::NODES_PER_FACE),
             _dim: PhantomData,
         })
     }
@@ -291,6 +298,34 @@ impl<D: Dim> Mesh<D> {
     /// Groups.
     pub fn groups(&self) -> &Groups {
         &self.groups
+    }
+
+    /// The interfaces (face-joints) and master-node map left by [`crate::split_nodes`];
+    /// none for a mesh that was not split.
+    pub fn interfaces(&self) -> &Interfaces {
+        &self.interfaces
+    }
+
+    /// Replaces the interfaces after checking them against this mesh.
+    pub(crate) fn set_interfaces(&mut self, mut interfaces: Interfaces) -> Result<(), MeshError> {
+        interfaces.check(self)?;
+        self.interfaces = interfaces;
+        Ok(())
+    }
+
+    /// Boundary faces that are not sides of an interface, ascending: the outer boundary
+    /// of the body before splitting (all boundary faces of a mesh that was not split).
+    pub fn outer_boundary(&self) -> Vec<u32> {
+        let mut side = vec![false; self.faces.len()];
+        for &f in self.interfaces.faces() {
+            side[f as usize] = true;
+        }
+        self.faces
+            .boundary
+            .iter()
+            .copied()
+            .filter(|&f| !side[f as usize])
+            .collect()
     }
 
     /// Gathers the coordinates of element `e` into `x` (`NODES_PER_ELEM * D` values).

@@ -5,8 +5,10 @@
 // the slip s = δ − o n; the model gives σ and the shear vector; side A receives
 // w A N_k (σ n + τ) and side B the opposite. Writes every slot of the joint, the joint
 // history, the joint damage (largest over the Gauss points) and, once broken, 1 on
-// both faces in `broken_face`. A joint already broken at the start of the step writes
-// zero slots and nothing else.
+// both faces in `broken_face`; and for every joint its opening δ̄·n, sliding δ̄ − (δ̄·n) n
+// and normal n, δ̄ the mean of the node-pair gaps (the gap at the face centroid). A
+// joint already broken at the start of the step writes these, zero slots and nothing
+// else.
 //
 // joint_info, stride INFO: side A nodes (NPF), side B nodes (NPF), faces A and B,
 // model kind, parameter offset. joint_data: Gauss points (N_0, N_1, N_2, weight) from
@@ -15,14 +17,6 @@
 fn kernel(j: u32) {
     let r = j * INFO;
     let s0 = (SLOT_FIRST + 2u * NPF * j) * D;
-    // A broken joint (largest damage 1, faces flagged) transfers no force: contact alone
-    // acts between its faces.
-    if joint_damage[j] >= 1.0 {
-        for (var i = 0u; i < 2u * NPF * D; i = i + 1u) {
-            slots[s0 + i] = Real(0.0);
-        }
-        return;
-    }
     var mid: array<Real, 9>;
     var gap: array<Real, 9>;
     for (var k = 0u; k < NPF; k = k + 1u) {
@@ -38,6 +32,31 @@ fn kernel(j: u32) {
     var n: array<Real, 3>;
     // Measure and unit normal of the midplane face.
     let area = face_measure_normal(mid, &n);
+    // Published kinematics: the gap at the face centroid split along the normal.
+    var gbar: JointVec;
+    for (var k = 0u; k < NPF; k = k + 1u) {
+        for (var c = 0u; c < D; c = c + 1u) {
+            gbar[c] = gbar[c] + gap[k * D + c];
+        }
+    }
+    var ob = Real(0.0);
+    for (var c = 0u; c < D; c = c + 1u) {
+        gbar[c] = gbar[c] / Real(NPF);
+        ob = ob + gbar[c] * n[c];
+    }
+    joint_opening[j] = ob;
+    for (var c = 0u; c < D; c = c + 1u) {
+        joint_sliding[j * D + c] = gbar[c] - ob * n[c];
+        joint_normal[j * D + c] = n[c];
+    }
+    // A broken joint (largest damage 1, faces flagged) transfers no force: contact alone
+    // acts between its faces.
+    if joint_damage[j] >= 1.0 {
+        for (var i = 0u; i < 2u * NPF * D; i = i + 1u) {
+            slots[s0 + i] = Real(0.0);
+        }
+        return;
+    }
     let kind = joint_info[r + 2u * NPF + 2u];
     let p = joint_info[r + 2u * NPF + 3u];
     let h = joint_data[H_AT + j];

@@ -15,11 +15,11 @@
 
 use std::time::Instant;
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, JOINT_DAMAGE};
+use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams, JOINT_DAMAGE};
 use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{output, Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::vtu::{DataArray, PvdSeries};
-use pcdc_mesh::{builders, Range};
+use pcdc_mesh::{builders, split_nodes, Range};
 
 use crate::report::SceneError;
 
@@ -114,12 +114,12 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     }
     .build()?;
     let rock = LinearElastic::new(E, 0.25, 2600.0)?.with_damping(0.5)?;
-    let joints = split.joints.clone();
+    let joints = split.interfaces().clone();
     let up = pcdc_compute::Table::new("edge velocity", &[(0.0, 0.0), (RAMP, V)])?;
     let down = pcdc_compute::Table::new("edge velocity", &[(0.0, 0.0), (RAMP, -V)])?;
-    let mut sim = Simulation::builder(split.mesh.clone(), backend.clone())
+    let mut sim = Simulation::builder(split, backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new(joints.clone()).model(Range::All, czm))
+        .physics(CohesiveJoints::new().model(Range::All, czm))
         .physics(
             Boundary::new()
                 .velocity(Range::group("bottom"), [None, Some(down.into()), None])
@@ -170,7 +170,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     let mut broken = Vec::new();
     for (j, &d) in damage.iter().enumerate() {
         if d >= 1.0 {
-            let n = &joints.nodes[4 * j..4 * j + 2];
+            let n = &joints.nodes()[4 * j..4 * j + 2];
             let (a, b) = (
                 sim.mesh().node(n[0] as usize),
                 sim.mesh().node(n[1] as usize),
@@ -196,12 +196,12 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
 fn write_frame(
     series: &mut PvdSeries,
     sim: &Simulation<pcdc_mesh::Dim2>,
-    joints: &pcdc_cohesive::Joints,
+    joints: &pcdc_mesh::Interfaces,
 ) -> Result<(), SceneError> {
     let damage = sim.field(JOINT_DAMAGE)?;
     let mut elem_damage = vec![0.0; sim.mesh().n_elements()];
     for (j, &d) in damage.iter().enumerate() {
-        for &e in &joints.elements[2 * j..2 * j + 2] {
+        for &e in &joints.elements()[2 * j..2 * j + 2] {
             elem_damage[e as usize] = f64::max(elem_damage[e as usize], d);
         }
     }

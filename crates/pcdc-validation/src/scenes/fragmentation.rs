@@ -23,11 +23,11 @@
 
 use std::time::Instant;
 
-use pcdc_cohesive::{split_nodes, CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
+use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
 use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
-use pcdc_mesh::{builders, Dim2, Mesh, Range};
+use pcdc_mesh::{builders, split_nodes, Dim2, Mesh, Range};
 
 use crate::report::SceneError;
 
@@ -118,9 +118,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     let (mesh, n_walls) = geometry(p.size)?;
     // FDEM region: the block (inside the box); the walls keep shared nodes.
     let inside = Range::rect(1e-9, 1e-9, BOX_W - 1e-9, BOX_H - 1e-9);
-    let split = split_nodes(&mesh, &inside)?;
-    let mut mesh = split.mesh;
-    let joints = split.joints;
+    let mut mesh = split_nodes(&mesh, &inside)?;
     let mut wall_nodes: Vec<u32> = (0..n_walls)
         .flat_map(|e| mesh.element(e).to_vec())
         .collect();
@@ -139,14 +137,13 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         penalty_overlap: 10.0 * E,
     }
     .build()?;
-    let bond_faces: Vec<u32> = joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(10.0 * E)
         .friction(30.0, 10.0 * E)
-        .bonded_pairs(&joints.elements, &bond_faces, BROKEN_FACE);
-    let n_joints = joints.len();
+        .bonded_interfaces(BROKEN_FACE);
+    let n_joints = mesh.interfaces().len();
     let mut sim = Simulation::builder(mesh, backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new(joints).model(Range::All, czm))
+        .physics(CohesiveJoints::new().model(Range::All, czm))
         .physics(contact)
         .physics(Boundary::new().fix(Range::group("walls")))
         .gravity([0.0, -9.81, 0.0])

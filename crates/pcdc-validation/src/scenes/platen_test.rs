@@ -14,14 +14,14 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use pcdc_cohesive::{
-    czm_state, split_nodes, CohesiveJoints, FailureMode, IntrinsicCzm, IntrinsicCzmParams,
-    BROKEN_FACE, JOINT_DAMAGE, JOINT_STATE,
+    czm_state, CohesiveJoints, FailureMode, IntrinsicCzm, IntrinsicCzmParams, BROKEN_FACE,
+    JOINT_DAMAGE, JOINT_STATE,
 };
 use pcdc_compute::{Backend, BackendKind, Simulation, Table, TimeValue};
 use pcdc_contact::Contact;
 use pcdc_mech::{output, Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::vtu::{DataArray, PvdSeries};
-use pcdc_mesh::{builders, Dim2, Mesh, Range};
+use pcdc_mesh::{builders, split_nodes, Dim2, Mesh, Range};
 
 use crate::report::SceneError;
 
@@ -578,9 +578,8 @@ pub(crate) fn run(
     // FDEM region: the specimen's elements (centroids strictly between the platens).
     let eps = 1e-9 * height;
     let in_specimen = Range::rect(f64::NEG_INFINITY, y0 + eps, f64::INFINITY, y1 - eps);
-    let split = split_nodes(&joined, &in_specimen)?;
-    let mesh = split.mesh;
-    let joints = split.joints;
+    let mesh = split_nodes(&joined, &in_specimen)?;
+    let joints = mesh.interfaces().clone();
     let ne = mesh.n_elements();
     // Nodes by body (element order is kept by the union and the split).
     let nodes_of = |r: std::ops::Range<usize>| {
@@ -622,11 +621,9 @@ pub(crate) fn run(
     }
     .model()?;
     let czm = s.joints.model(e)?;
-    let bond_elements = joints.elements.clone();
-    let bond_faces: Vec<u32> = joints.faces.iter().step_by(2).copied().collect();
     let contact = Contact::new(s.contact.penalty * e)
         .friction(s.contact.friction_deg, s.contact.penalty * e)
-        .bonded_pairs(&bond_elements, &bond_faces, BROKEN_FACE);
+        .bonded_interfaces(BROKEN_FACE);
     let v = s.loading.platen_velocity;
     let ramp = s.loading.ramp_time.max(0.0);
     let table = |sign: f64| -> Result<TimeValue, pcdc_compute::ComputeError> {
@@ -642,7 +639,7 @@ pub(crate) fn run(
                 .material(Range::All, rock)
                 .material(in_specimen.clone().complement(), steel),
         )
-        .physics(CohesiveJoints::new(joints.clone()).model(Range::All, czm))
+        .physics(CohesiveJoints::new().model(Range::All, czm))
         .physics(contact)
         .physics(
             Boundary::new()
@@ -800,7 +797,7 @@ fn reaction_chunk(kind: BackendKind, every: u64) -> u64 {
 /// the first of its Gauss points that broke with a recorded mode.
 fn broken_joints(
     sim: &Simulation<Dim2>,
-    joints: &pcdc_cohesive::Joints,
+    joints: &pcdc_mesh::Interfaces,
 ) -> Result<(BrokenCount, Vec<Crack>), SceneError> {
     let damage = sim.field(JOINT_DAMAGE)?;
     let state = sim.field(JOINT_STATE)?;
@@ -823,7 +820,7 @@ fn broken_joints(
             FailureMode::Shear => count.shear += 1,
             _ => count.mixed += 1,
         }
-        let n = &joints.nodes[4 * j..4 * j + 2];
+        let n = &joints.nodes()[4 * j..4 * j + 2];
         let (a, b) = (
             sim.mesh().node(n[0] as usize),
             sim.mesh().node(n[1] as usize),
@@ -842,14 +839,14 @@ fn broken_joints(
 fn write_frame(
     series: &mut PvdSeries,
     sim: &Simulation<Dim2>,
-    joints: &pcdc_cohesive::Joints,
+    joints: &pcdc_mesh::Interfaces,
 ) -> Result<(), SceneError> {
     let damage = sim.field(JOINT_DAMAGE)?;
     let ne = sim.mesh().n_elements();
     let mut elem_damage = vec![0.0; ne];
     let mut elem_broken = vec![0i32; ne];
     for (j, &d) in damage.iter().enumerate() {
-        for &e in &joints.elements[2 * j..2 * j + 2] {
+        for &e in &joints.elements()[2 * j..2 * j + 2] {
             let e = e as usize;
             elem_damage[e] = f64::max(elem_damage[e], d);
             if d >= 1.0 {

@@ -11,7 +11,7 @@
 //! elasticity: we use E = 30 GPa, ν = 0.25, ρ = 2600 kg/m³. Two elastic steel platens
 //! of 0.010 × 0.056 m (E = 200 GPa, ν = 0.3, ρ = 7800 kg/m³) touch the sample's ends and
 //! move towards each other; contact (penalty 10 E, friction 30°) acts between platens
-//! and sample and on the faces of broken joints ([`Contact::bonded_pairs`]).
+//! and sample and on the faces of broken joints ([`Contact::bonded_interfaces`]).
 //!
 //! Measurements: axial stress = mean platen reaction per unit thickness / sample width;
 //! axial strain = shortening of the sample between its top and bottom nodes / height
@@ -28,7 +28,7 @@
 //! whose vertical joints (parallel to the load) add none. The runs agree with the closed
 //! form to 0.2 %.
 //!
-//! [`Contact::bonded_pairs`]: pcdc_contact::Contact::bonded_pairs
+//! [`Contact::bonded_interfaces`]: pcdc_contact::Contact::bonded_interfaces
 
 use serde::{Deserialize, Serialize};
 
