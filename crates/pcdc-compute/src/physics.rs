@@ -434,6 +434,16 @@ pub trait Physics<D: Dim>: Send + Sync {
         )))
     }
 
+    /// Checks the values of this physics' fields in a state that a restore is about to
+    /// accept (they come from a file, with a valid checksum but possibly forged): values
+    /// the physics uses as indices, counts or flags must be checked here and refused with
+    /// [`ComputeError::SnapshotCorrupt`], never trusted (a later step must not panic).
+    /// Called after [`Physics::init`], before anything changes; the default accepts any
+    /// values.
+    fn check_fields(&self, _fields: &FieldStore) -> Result<(), ComputeError> {
+        Ok(())
+    }
+
     /// A fingerprint of this physics' parameters (materials, laws, ranges; not its
     /// evolving state), e.g. built with [`crate::Fingerprint`], called after
     /// [`Physics::init`]. Snapshots store it and a restore into a physics whose

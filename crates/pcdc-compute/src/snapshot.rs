@@ -37,8 +37,9 @@
 //!    and no node displaced beyond the simulation's runaway limit (the watchdog's own
 //!    criterion, so a state saved after a divergence is refused); the step counter is
 //!    not tied to the time, because the time step may change during a run;
-//! 8. each physics checks its own state in [`crate::Physics::restore_state`] (e.g. the
-//!    contact physics range-checks every candidate index).
+//! 8. each physics checks the values of its fields in [`crate::Physics::check_fields`]
+//!    (e.g. the contact physics range-checks every candidate index of its lists) and
+//!    the state it keeps outside them in [`crate::Physics::restore_state`].
 //!
 //! Nothing is changed unless every check passes: a physics whose state was already
 //! restored when a later one fails gets its previous state back. A damaged or foreign
@@ -250,6 +251,9 @@ impl<D: Dim> Simulation<D> {
         }
         self.check_scene(&snap)?;
         self.check_values(&snap)?;
+        for p in &self.physics {
+            p.check_fields(&snap.state.fields)?;
+        }
         self.restore_physics(&snap.physics_state)?;
         self.state = snap.state;
         self.dt = snap.dt;
