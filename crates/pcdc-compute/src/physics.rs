@@ -413,8 +413,10 @@ pub trait Physics<D: Dim>: Send + Sync {
     /// Kinematic constraints for the direct static solve.
     fn dof_constraints(&self, _mesh: &Mesh<D>, _out: &mut Vec<DofConstraint>) {}
 
-    /// State this physics keeps outside the fields (e.g. contact pair histories), encoded
-    /// for a snapshot; the default has none.
+    /// State this physics keeps outside the fields, encoded for a snapshot; the default
+    /// has none. Prefer fields for evolving state (they reach the GPU, and a snapshot
+    /// holds them on both backends; check their values in [`Physics::check_fields`]):
+    /// this hook remains for user physics that keep host-only state.
     fn save_state(&self) -> Result<Vec<u8>, ComputeError> {
         Ok(Vec::new())
     }

@@ -371,8 +371,8 @@ mod tests {
         }
     }
 
-    /// Every contact kernel, 2D and 3D, with the built-in law (friction and damping) and
-    /// with surface contact, validates with naga, f64 and f32.
+    /// Every contact kernel, 2D and 3D, with the built-in law (friction and damping, and
+    /// friction alone) and with surface contact, validates with naga, f64 and f32.
     #[test]
     fn contact_kernels_validate() {
         let (m2, m3) = (two_blocks(), two_cubes());
@@ -380,6 +380,10 @@ mod tests {
             let law = || Contact::new(1e10).friction(30.0, 1e11).damping(1e6, 2.0);
             validate_all(&m2, law(), p);
             validate_all(&m3, law(), p);
+            // Friction without damping: one history value per pair.
+            let friction = || Contact::new(1e10).friction(30.0, 1e11);
+            validate_all(&m2, friction(), p);
+            validate_all(&m3, friction(), p);
             let ne = m3.n_elements();
             let surface = Contact::new(1e10).surface_defaults(vec![25.0; ne], vec![1e10; ne]);
             validate_all(&m3, surface, p);

@@ -11,9 +11,10 @@
 //! exactly and no atomics are needed. Elements sharing a node (one continuous body)
 //! do not contact each other.
 //!
-//! Per pair the physics keeps three history values, carried across rebuilds and
-//! snapshots: the accumulated slip δ_s of the friction law (eq. 59-60) and, for contact
-//! damping (eq. 61), the largest trial normal stress reached and the stress held there.
+//! Per pair the physics keeps the law's history, carried across rebuilds and snapshots:
+//! for `contact-m-c` the accumulated slip δ_s of the friction law (eq. 59-60) and, with
+//! contact damping (eq. 61), the largest trial normal stress reached and the stress held
+//! there.
 //!
 //! # State in fields
 //!

@@ -217,4 +217,3 @@ fn snapshots_cross_backends() {
         assert!(du <= 1e-12 && dv <= 1e-11, "{what}: du {du:e}, dv {dv:e}");
     }
 }
-
