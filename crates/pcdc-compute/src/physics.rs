@@ -421,8 +421,10 @@ pub trait Physics<D: Dim>: Send + Sync {
     /// Kinematic constraints for the direct static solve.
     fn dof_constraints(&self, _mesh: &Mesh<D>, _out: &mut Vec<DofConstraint>) {}
 
-    /// State this physics keeps outside the fields (e.g. contact pair histories), encoded
-    /// for a snapshot; the default has none.
+    /// State this physics keeps outside the fields, encoded for a snapshot; the default
+    /// has none. Prefer fields for evolving state (they reach the GPU, and a snapshot
+    /// holds them on both backends; check their values in [`Physics::check_fields`]):
+    /// this hook remains for user physics that keep host-only state.
     fn save_state(&self) -> Result<Vec<u8>, ComputeError> {
         Ok(Vec::new())
     }
@@ -440,6 +442,16 @@ pub trait Physics<D: Dim>: Send + Sync {
             self.name(),
             bytes.len()
         )))
+    }
+
+    /// Checks the values of this physics' fields in a state that a restore is about to
+    /// accept (they come from a file, with a valid checksum but possibly forged): values
+    /// the physics uses as indices, counts or flags must be checked here and refused with
+    /// [`ComputeError::SnapshotCorrupt`], never trusted (a later step must not panic).
+    /// Called after [`Physics::init`], before anything changes; the default accepts any
+    /// values.
+    fn check_fields(&self, _fields: &FieldStore) -> Result<(), ComputeError> {
+        Ok(())
     }
 
     /// A fingerprint of this physics' parameters (materials, laws, ranges; not its

@@ -2,7 +2,7 @@
 //! [`Simulation::restore`], [`Simulation::snapshot_bytes`],
 //! [`Simulation::restore_bytes`]).
 //!
-//! # Format (version 3)
+//! # Format (version 4)
 //!
 //! A fixed 24-byte header, all integers little-endian, then a postcard payload:
 //!
@@ -13,6 +13,11 @@
 //! | 12 | 4 | CRC-32 (IEEE, as zlib and PNG) of every byte from offset 16 to the end |
 //! | 16 | 8 | payload length in bytes, `u64` |
 //! | 24 | n | payload (postcard): dimension, node and element counts, mesh fingerprint, physics names, per-physics fingerprints, layout fingerprint, time step, [`crate::State`], and per physics the state it keeps outside the fields ([`crate::Physics::save_state`]) |
+//!
+//! Version 4 has the layout of version 3; what changed is where the contact physics
+//! keeps its state: its candidate lists and pair histories are fields (in
+//! [`crate::State`]) instead of its own bytes, so a version-3 file of a scene with
+//! contact could not be continued and every version-3 file is refused by its version.
 //!
 //! # What a restore checks, in order
 //!
@@ -37,8 +42,9 @@
 //!    and no node displaced beyond the simulation's runaway limit (the watchdog's own
 //!    criterion, so a state saved after a divergence is refused); the step counter is
 //!    not tied to the time, because the time step may change during a run;
-//! 8. each physics checks its own state in [`crate::Physics::restore_state`] (e.g. the
-//!    contact physics range-checks every candidate index).
+//! 8. each physics checks the values of its fields in [`crate::Physics::check_fields`]
+//!    (e.g. the contact physics range-checks every candidate index of its lists) and
+//!    the state it keeps outside them in [`crate::Physics::restore_state`].
 //!
 //! Nothing is changed unless every check passes: a physics whose state was already
 //! restored when a later one fails gets its previous state back. A damaged or foreign
@@ -57,7 +63,7 @@ use crate::{ComputeError, Fingerprint, Simulation, State};
 pub const SNAPSHOT_MAGIC: [u8; 8] = *b"PCDCSNAP";
 
 /// The snapshot format version this build writes and reads.
-pub const SNAPSHOT_VERSION: u32 = 3;
+pub const SNAPSHOT_VERSION: u32 = 4;
 
 /// Header length in bytes (magic, version, checksum, payload length).
 pub const SNAPSHOT_HEADER_LEN: usize = 24;
@@ -103,7 +109,7 @@ fn mismatch(what: impl Into<String>) -> ComputeError {
     ComputeError::SnapshotMismatch(what.into())
 }
 
-/// Wraps a payload in the version-3 header.
+/// Wraps a payload in the header.
 fn seal(payload: &[u8]) -> Vec<u8> {
     let mut out = Vec::with_capacity(SNAPSHOT_HEADER_LEN + payload.len());
     out.extend_from_slice(&SNAPSHOT_MAGIC);
@@ -250,6 +256,9 @@ impl<D: Dim> Simulation<D> {
         }
         self.check_scene(&snap)?;
         self.check_values(&snap)?;
+        for p in &self.physics {
+            p.check_fields(&snap.state.fields)?;
+        }
         self.restore_physics(&snap.physics_state)?;
         self.state = snap.state;
         self.dt = snap.dt;

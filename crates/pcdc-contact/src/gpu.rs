@@ -34,7 +34,16 @@
 //! raise flags; no float atomics. The order inside a bucket depends on scheduling, but
 //! the lists are sorted, so the forces do not.
 //!
-//! Lists have a fixed capacity per element ([`crate::Contact::gpu_capacity`]; default
+//! The candidate lists, their counts and the pair histories are the contact physics'
+//! fields (layout in the `physics` module docs, shared with the CPU path), so they are
+//! uploaded with the host state at every run, read back at its end and saved by a
+//! snapshot: a GPU run restored from a snapshot continues bit for bit, pair history
+//! included. The lists hold element indices as reals (exact in f32 below 2^24 elements,
+//! which the setup checks). Scratch buffers (boxes, buckets, the old lists and histories
+//! a rebuild reads while it writes the new ones) are device-only and rewritten on every
+//! rebuild step.
+//!
+//! Lists have a fixed capacity per element ([`crate::Contact::capacity`]; default
 //! twice the largest initial list, at least 48): an element that finds more candidates
 //! stops the run with an error naming it. The single-invocation `scan` loops over all
 //! buckets; it runs on rebuild steps only.
@@ -45,9 +54,7 @@
 //! in private memory (about 3.4 kB per invocation in f64), the `candidates` kernel a
 //! sorted list of `CAP` indices.
 //!
-//! Limitations: the pair history lives on the device (a snapshot of a GPU run holds the
-//! candidate reference positions but not the friction slip, which restarts at zero after
-//! a restore). The 3D pair force is heavy per invocation (face clipping with divergent
+//! Limitations: the 3D pair force is heavy per invocation (face clipping with divergent
 //! branches): on lavapipe (Vulkan on the CPU), with the 2 cores of this project's
 //! machine shared, the 3D parity scene (96 tetrahedra) took 13 s for 456 steps.
 
@@ -72,10 +79,10 @@ pub(crate) struct GpuContactInput<'a> {
     /// Bonded neighbours per element (neighbour, face), sorted, and the broken-face
     /// field name.
     pub bonds: Option<(&'a [BondList], &'a str)>,
-    /// Candidate capacity per element, if set by the user.
-    pub capacity: Option<usize>,
-    /// Name of the reference-position field.
-    pub reference: &'a str,
+    /// Candidate capacity per element (the components of the candidate field).
+    pub capacity: usize,
+    /// History values per pair in the history field.
+    pub stride: usize,
 }
 
 /// Declares the contact kernels.
@@ -98,41 +105,16 @@ pub(crate) fn setup<D: Dim>(
     if ne == 0 {
         return Ok(());
     }
-    let ns = model.n_state().max(1);
-    // Capacity: twice the largest list of the initial configuration, at least 48.
-    let capacity = match input.capacity {
-        Some(0) => {
-            return Err(ComputeError::param(
-                "Contact::gpu_capacity",
-                0,
-                "must be at least 1 candidate per element",
-            ))
-        }
-        Some(c) => c,
-        None => {
-            // The CPU broad phase on the initial configuration (zero displacement).
-            let zeros = vec![0.0; mesh.n_nodes() * D::D];
-            let mass = vec![0.0; mesh.n_nodes()];
-            let kin = pcdc_compute::Kinematics {
-                mesh,
-                coords: mesh.coords(),
-                mass: &mass,
-                u: &zeros,
-                v: &zeros,
-                time: 0.0,
-                dt: 0.0,
-                step: 0,
-                damping: false,
-            };
-            let margin = 0.5 * input.skin;
-            let lists = if D::D == 3 {
-                crate::grid_candidates_3d(&crate::element_boxes_3d(&kin, margin), mesh.elements())
-            } else {
-                crate::grid_candidates(&crate::element_boxes(&kin, margin), mesh.elements())
-            };
-            (2 * lists.iter().map(Vec::len).max().unwrap_or(0)).max(48)
-        }
-    };
+    let (capacity, ns) = (input.capacity, input.stride);
+    if setup.precision() == Precision::F32 && ne >= 1 << 24 {
+        return Err(ComputeError::NoGpuKernel {
+            physics: "contact".into(),
+            reason: format!(
+                "{ne} elements: f32 kernels hold candidate indices exactly only below 2^24 \
+                 elements; use f64"
+            ),
+        });
+    }
     let nbuckets = (2 * ne).next_power_of_two();
     let splice = splice_models(
         "contact_model",
@@ -153,11 +135,14 @@ pub(crate) fn setup<D: Dim>(
     let fill = setup.atomics("bucket fill", nbuckets);
     let start = setup.upload("bucket starts", GpuData::U32(vec![0; nbuckets + 1]));
     let items = setup.upload("bucket items", GpuData::U32(vec![0; ne]));
-    let cand = setup.upload("candidates", GpuData::U32(vec![0; ne * capacity]));
+    // The state: fields (uploaded and read back with the host state).
+    let cand = setup.field(crate::CONTACT_CANDIDATES)?;
+    let ncand = setup.field(crate::CONTACT_CANDIDATE_COUNT)?;
+    let hist = setup.field(crate::CONTACT_HISTORY)?;
+    let reference = setup.field(crate::CONTACT_REFERENCE)?;
+    // Scratch of a rebuild: the old lists and histories.
     let cand_old = setup.upload("old candidates", GpuData::U32(vec![0; ne * capacity]));
-    let ncand = setup.upload("candidate counts", GpuData::U32(vec![0; ne]));
     let ncand_old = setup.upload("old candidate counts", GpuData::U32(vec![0; ne]));
-    let hist = setup.upload("pair history", GpuData::Real(vec![0.0; ne * capacity * ns]));
     let hist_old = setup.upload(
         "old pair history",
         GpuData::Real(vec![0.0; ne * capacity * ns]),
@@ -186,13 +171,7 @@ pub(crate) fn setup<D: Dim>(
         Some(b) => b,
         None => setup.upload("no bonds", GpuData::Real(vec![0.0])),
     };
-    let reference = setup.field(input.reference)?;
-    let overflow = setup.error(move |e| {
-        format!(
-            "element {e} has more than {capacity} contact candidates on the GPU; raise \
-             Contact::gpu_capacity"
-        )
-    });
+    let overflow = setup.error(move |e| crate::physics::overflow_message(e, capacity));
     let tiny = match setup.precision() {
         Precision::F64 => f64::MIN_POSITIVE,
         Precision::F32 => 1e-30,
@@ -392,8 +371,8 @@ mod tests {
         }
     }
 
-    /// Every contact kernel, 2D and 3D, with the built-in law (friction and damping) and
-    /// with surface contact, validates with naga, f64 and f32.
+    /// Every contact kernel, 2D and 3D, with the built-in law (friction and damping, and
+    /// friction alone) and with surface contact, validates with naga, f64 and f32.
     #[test]
     fn contact_kernels_validate() {
         let (m2, m3) = (two_blocks(), two_cubes());
@@ -401,6 +380,10 @@ mod tests {
             let law = || Contact::new(1e10).friction(30.0, 1e11).damping(1e6, 2.0);
             validate_all(&m2, law(), p);
             validate_all(&m3, law(), p);
+            // Friction without damping: one history value per pair.
+            let friction = || Contact::new(1e10).friction(30.0, 1e11);
+            validate_all(&m2, friction(), p);
+            validate_all(&m3, friction(), p);
             let ne = m3.n_elements();
             let surface = Contact::new(1e10).surface_defaults(vec![25.0; ne], vec![1e10; ne]);
             validate_all(&m3, surface, p);
@@ -410,11 +393,11 @@ mod tests {
     /// A zero candidate capacity is a parameter error, not an invalid shader.
     #[test]
     fn zero_capacity_is_named() {
-        let e = sources(Contact::new(1e10).gpu_capacity(0), Precision::F64)
+        let e = sources(Contact::new(1e10).capacity(0), Precision::F64)
             .map(|_| ())
             .unwrap_err()
             .to_string();
-        assert!(e.contains("gpu_capacity"), "{e}");
+        assert!(e.contains("Contact::capacity"), "{e}");
     }
 
     #[derive(Debug)]

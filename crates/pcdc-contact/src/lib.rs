@@ -22,8 +22,14 @@
 //! sort and the pair forces run element-centric in WGSL, repeating the CPU arithmetic
 //! (f64 results match the CPU to rounding); laws supply their WGSL through
 //! [`ContactModel::wgsl`] ([`WgslContactModel`]). See the `gpu` module notes in the
-//! source for the kernel sequence, resources and the candidate capacity
-//! ([`Contact::gpu_capacity`]).
+//! source for the kernel sequence and resources.
+//!
+//! All evolving contact state (candidate lists, their reference positions and the
+//! per-pair histories of the law) lives in fields with one layout for both backends
+//! ([`CONTACT_CANDIDATES`], [`CONTACT_CANDIDATE_COUNT`], [`CONTACT_HISTORY`],
+//! [`CONTACT_REFERENCE`]; a fixed capacity per element, [`Contact::capacity`]), so a
+//! snapshot of a CPU or GPU run restores it completely and the continuation is bit
+//! for bit the uninterrupted run.
 
 #![warn(missing_docs)]
 // Index loops mirror the formulas.
@@ -42,7 +48,7 @@ pub use model::{
 };
 pub use physics::{
     element_boxes, element_boxes_3d, grid_candidates, grid_candidates_3d, Contact,
-    CONTACT_REFERENCE,
+    CONTACT_CANDIDATES, CONTACT_CANDIDATE_COUNT, CONTACT_HISTORY, CONTACT_REFERENCE,
 };
 pub use potential2d::{potential, triangle_pair_force, PairForce2};
 pub use potential3d::{tet_pair_force, tet_potential, PairForce3};

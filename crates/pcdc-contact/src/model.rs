@@ -162,8 +162,10 @@ pub struct ContactDamping {
 /// The built-in law `contact-m-c` (table 8): normal penalty, optional Coulomb friction
 /// with shear penalty (eq. 59-60) and optional damping (eq. 61).
 ///
-/// History per pair: accumulated slip δ_s (m), largest trial normal stress σ_try,max
-/// (Pa), normal stress held there σ_max (Pa).
+/// History per pair: accumulated slip δ_s (m); with damping also the largest trial
+/// normal stress σ_try,max (Pa) and the normal stress held there σ_max (Pa). Without
+/// damping the history is δ_s alone ([`ContactModel::n_state`] 1 instead of 3), which
+/// keeps the contact fields of a frictional scene a third of the size.
 ///
 /// Damping: the overlap is proportional to the trial stress under the penalty law, so
 /// o_n / o_n,max = σ_try / σ_try,max. Loading (σ_try at its maximum so far):
@@ -193,7 +195,11 @@ impl ContactModel for MohrCoulombContact {
         self.friction.map_or(0.0, |f| f.penalty)
     }
     fn n_state(&self) -> usize {
-        3
+        if self.damping.is_some() {
+            3
+        } else {
+            1
+        }
     }
     fn check(&self) -> Result<(), ComputeError> {
         if !(self.normal_penalty > 0.0 && self.normal_penalty.is_finite()) {
@@ -279,9 +285,19 @@ impl ContactModel for MohrCoulombContact {
             Some(d) => (1.0, d.transition, d.exponent),
             None => (0.0, 0.0, 1.0),
         };
+        let body = include_str!("shaders/mohr_coulomb_contact.wgsl");
+        // Without damping the history holds δ_s only: drop the damping lines, which
+        // index entries 1 and 2.
+        let (key, body) = match (body.find("// DAMPING BEGIN"), body.find("// DAMPING END")) {
+            (Some(a), Some(b)) if d_on == 0.0 => (
+                "contact_m_c_friction",
+                format!("{}{}", &body[..a], &body[b..]),
+            ),
+            _ => ("contact_m_c", body.to_string()),
+        };
         Some(WgslContactModel {
-            key: "contact_m_c".into(),
-            body: include_str!("shaders/mohr_coulomb_contact.wgsl").into(),
+            key: key.into(),
+            body,
             params: vec![fr_on, tan_phi, pt, d_on, t, b],
             pair_penalty: None,
         })
@@ -328,7 +344,8 @@ impl ContactModel for SurfaceContact {
         self.normal_penalty()
     }
     fn n_state(&self) -> usize {
-        3
+        // δ_s only: the pair law has no damping.
+        1
     }
     fn check(&self) -> Result<(), ComputeError> {
         if self.penalty.len() != self.friction_deg.len() {

@@ -11,9 +11,36 @@
 //! exactly and no atomics are needed. Elements sharing a node (one continuous body)
 //! do not contact each other.
 //!
-//! Per pair the physics keeps three history values, carried across rebuilds and
-//! snapshots: the accumulated slip δ_s of the friction law (eq. 59-60) and, for contact
-//! damping (eq. 61), the largest trial normal stress reached and the stress held there.
+//! Per pair the physics keeps the law's history, carried across rebuilds and snapshots:
+//! for `contact-m-c` the accumulated slip δ_s of the friction law (eq. 59-60) and, with
+//! contact damping (eq. 61), the largest trial normal stress reached and the stress held
+//! there.
+//!
+//! # State in fields
+//!
+//! Everything that evolves lives in fields, in one layout that the CPU path and the GPU
+//! kernels share, so a snapshot of either backend holds the whole contact state and a
+//! restore continues bit for bit:
+//!
+//! - [`CONTACT_REFERENCE`] (per node, D values): node positions at the last broad-phase
+//!   build (NaN before the first build, which forces one);
+//! - [`CONTACT_CANDIDATE_COUNT`] (per element, 1 value): the length n of the element's
+//!   candidate list;
+//! - [`CONTACT_CANDIDATES`] (per element, `capacity` values): the list, partner element
+//!   indices stored as reals (exact: below 2^53, and below 2^24 for f32 kernels, which
+//!   the GPU setup checks), strictly increasing; entries from n on are 0;
+//! - [`CONTACT_HISTORY`] (per element, `capacity × s` values, s = the law's
+//!   [`ContactModel::n_state`], at least 1): the history of pair k at `k s .. (k + 1) s`,
+//!   in list order; both elements of a pair keep identical copies; entries from n s on
+//!   are 0.
+//!
+//! The capacity per element is fixed when the simulation is built ([`Contact::capacity`];
+//! default twice the largest list of the initial configuration, at least 48): a rebuild
+//! that finds more candidates for an element stops the run with an error naming the
+//! element, on both backends, never dropping a pair silently. The physics struct keeps
+//! only parameters and data derived once from the mesh. A restore checks the lists
+//! (range, order, symmetry, zero tails) before accepting them
+//! ([`Physics::check_fields`]).
 //!
 //! Elements bonded by an intact cohesive joint do not contact each other once the bonds
 //! are declared, from the mesh's interfaces with [`Contact::bonded_interfaces`] or as
@@ -36,8 +63,6 @@
 //!   stored tangential spring force when the sliding direction turns), and no shear acts
 //!   while v_t = 0.
 
-use std::sync::Mutex;
-
 use pcdc_compute::{Components, FieldAccess, FieldKey, FieldUse, Place};
 use pcdc_compute::{
     ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
@@ -52,16 +77,39 @@ use std::sync::Arc;
 use crate::model::{ContactDamping, ContactModel, Friction, MohrCoulombContact};
 use crate::{tet_pair_force, triangle_pair_force, PairForce2, PairForce3};
 
-/// Node positions at the last broad-phase build (m), stride D.
+/// Node positions at the last broad-phase build (m), stride D (node field).
 pub const CONTACT_REFERENCE: FieldKey = FieldKey::new(
     "contact_reference_positions",
     Place::Node,
     Components::Vector,
 );
 
-/// The error of a lock poisoned by an earlier panic.
-fn poisoned_state() -> ComputeError {
-    ComputeError::physics("contact", "state poisoned by an earlier panic")
+/// Length of every element's candidate list (element field, 1 value).
+pub const CONTACT_CANDIDATE_COUNT: FieldKey = FieldKey::new(
+    "contact_candidate_count",
+    Place::Element,
+    Components::Fixed(1),
+);
+
+/// Candidate lists: per element `capacity` partner indices, sorted, zero past the list's
+/// length (element field; see the module docs).
+pub const CONTACT_CANDIDATES: FieldKey =
+    FieldKey::new("contact_candidates", Place::Element, Components::Declared);
+
+/// Pair histories: per element and candidate the law's state values, in list order
+/// (element field, `capacity × max(n_state, 1)` values; see the module docs).
+pub const CONTACT_HISTORY: FieldKey =
+    FieldKey::new("contact_pair_history", Place::Element, Components::Declared);
+
+/// Smallest default candidate capacity per element.
+const MIN_CAPACITY: usize = 48;
+
+/// The error of an element whose candidates exceed the capacity (both backends).
+pub(crate) fn overflow_message(e: u32, capacity: usize) -> String {
+    format!(
+        "element {e} has more than {capacity} contact candidates (the capacity per element); \
+         raise Contact::capacity"
+    )
 }
 
 /// Applies the contact law to a pair's normal (potential) forces: trial stress
@@ -215,14 +263,25 @@ pub struct Contact {
     /// Elements of the mesh (set by init; bounds the candidate indices of a restore).
     n_elements: usize,
     skin: Option<f64>,
-    gpu_capacity: Option<usize>,
+    /// Candidate capacity per element set by the user.
+    capacity: Option<usize>,
     bonds: Option<Bonds>,
     skin_used: f64,
-    reference: Option<FieldId>,
-    candidates: Mutex<Vec<Vec<u32>>>,
-    /// Pair history per element and candidate (same order as the candidate lists),
-    /// `n_state` values each; both elements of a pair update identical copies.
-    slips: Mutex<Vec<Vec<f64>>>,
+    /// The state fields (set by init).
+    ids: Option<StateIds>,
+}
+
+/// The contact physics' fields and their strides (see the module docs).
+#[derive(Clone, Copy, Debug)]
+struct StateIds {
+    reference: FieldId,
+    count: FieldId,
+    candidates: FieldId,
+    history: FieldId,
+    /// Candidates per element.
+    capacity: usize,
+    /// History values per pair in the history field (the law's count, at least 1).
+    stride: usize,
 }
 
 /// Element pairs bonded through a face (e.g. by a cohesive joint) and the face field
@@ -264,12 +323,10 @@ impl Contact {
             n_state: 0,
             n_elements: 0,
             skin: None,
-            gpu_capacity: None,
+            capacity: None,
             bonds: None,
             skin_used: 0.0,
-            reference: None,
-            candidates: Mutex::new(Vec::new()),
-            slips: Mutex::new(Vec::new()),
+            ids: None,
         }
     }
 
@@ -355,12 +412,72 @@ impl Contact {
         self
     }
 
-    /// Candidate-list capacity per element on the GPU (default: twice the largest
-    /// initial list, at least 48); a run that needs more stops with an error naming the
-    /// element.
-    pub fn gpu_capacity(mut self, capacity: usize) -> Self {
-        self.gpu_capacity = Some(capacity);
+    /// Candidate-list capacity per element, on both backends (default: twice the
+    /// largest list of the initial configuration, at least 48). The lists and pair
+    /// histories are fields of this fixed size (see the module docs), so the capacity is
+    /// part of the simulation's layout: a broad-phase build that finds more candidates
+    /// for an element stops the run with an error naming the element, and a snapshot
+    /// restores only into a simulation of the same capacity.
+    pub fn capacity(mut self, capacity: usize) -> Self {
+        self.capacity = Some(capacity);
         self
+    }
+
+    /// The former name of [`Contact::capacity`] (the capacity now applies on both
+    /// backends).
+    #[deprecated(note = "use Contact::capacity: the capacity applies on both backends")]
+    pub fn gpu_capacity(self, capacity: usize) -> Self {
+        self.capacity(capacity)
+    }
+
+    /// The law in force: the custom model or the built-in `contact-m-c`.
+    fn law(&self) -> Arc<dyn ContactModel> {
+        match &self.custom {
+            Some(m) => m.clone(),
+            None => Arc::new(MohrCoulombContact {
+                normal_penalty: self.penalty,
+                friction: self.friction,
+                damping: self.damping,
+            }),
+        }
+    }
+
+    /// The skin for `mesh`: the one set, or half the smallest element edge.
+    fn skin_for<D: Dim>(&self, mesh: &Mesh<D>) -> f64 {
+        self.skin
+            .unwrap_or_else(|| 0.5 * mesh.edge_length_range().0)
+    }
+
+    /// The candidate capacity per element for `mesh`: the one set, or twice the largest
+    /// list of the CPU broad phase on the initial configuration, at least 48 (an invalid
+    /// skin, which init reports, gives the minimum).
+    fn capacity_for<D: Dim>(&self, mesh: &Mesh<D>) -> usize {
+        if let Some(c) = self.capacity {
+            return c;
+        }
+        let skin = self.skin_for(mesh);
+        if !(skin > 0.0 && skin.is_finite()) || mesh.n_elements() == 0 {
+            return MIN_CAPACITY;
+        }
+        let zeros = vec![0.0; mesh.n_nodes() * D::D];
+        let mass = vec![0.0; mesh.n_nodes()];
+        let kin = Kinematics {
+            mesh,
+            coords: mesh.coords(),
+            mass: &mass,
+            u: &zeros,
+            v: &zeros,
+            time: 0.0,
+            dt: 0.0,
+            step: 0,
+            damping: false,
+        };
+        let lists = if D::D == 3 {
+            grid_candidates_3d(&element_boxes_3d(&kin, 0.5 * skin), mesh.elements())
+        } else {
+            grid_candidates(&element_boxes(&kin, 0.5 * skin), mesh.elements())
+        };
+        (2 * lists.iter().map(Vec::len).max().unwrap_or(0)).max(MIN_CAPACITY)
     }
 
     /// Skin distance of the broad phase (m); default half the smallest element edge.
@@ -735,14 +852,70 @@ pub fn grid_candidates_3d(boxes: &[[f64; 6]], conn: &[u32]) -> Vec<Vec<u32>> {
         .collect()
 }
 
+/// Writes freshly built candidate lists into the state fields, carrying the history of
+/// pairs that stay candidates (both lists are sorted: a binary search in the old list)
+/// and zeroing the entries past each new list. An element with more candidates than
+/// the capacity is an error, raised before any field changes.
+fn store_lists(
+    fresh: &[Vec<u32>],
+    fields: &mut FieldStore,
+    ids: StateIds,
+) -> Result<(), ComputeError> {
+    let (cap, s) = (ids.capacity, ids.stride);
+    if let Some(e) = fresh.iter().position(|l| l.len() > cap) {
+        return Err(ComputeError::physics(
+            "contact",
+            overflow_message(e as u32, cap),
+        ));
+    }
+    let [count, cand, hist] = fields.get_many_mut([ids.count, ids.candidates, ids.history]);
+    count
+        .par_iter_mut()
+        .zip(cand.par_chunks_mut(cap))
+        .zip(hist.par_chunks_mut(cap * s))
+        .zip(fresh.par_iter())
+        .for_each_init(
+            || (Vec::new(), Vec::new()),
+            |(old, old_hist): &mut (Vec<u32>, Vec<f64>), (((n, row), hrow), list)| {
+                let n_old = (*n as usize).min(cap);
+                old.clear();
+                old.extend(row[..n_old].iter().map(|&f| f as u32));
+                old_hist.clear();
+                old_hist.extend_from_slice(&hrow[..n_old * s]);
+                for (k, &f) in list.iter().enumerate() {
+                    row[k] = f as f64;
+                    let h = &mut hrow[k * s..(k + 1) * s];
+                    match old.binary_search(&f) {
+                        Ok(j) => h.copy_from_slice(&old_hist[j * s..(j + 1) * s]),
+                        Err(_) => h.fill(0.0),
+                    }
+                }
+                let m = list.len();
+                if n_old > m {
+                    row[m..n_old].fill(0.0);
+                    hrow[m * s..n_old * s].fill(0.0);
+                }
+                *n = m as f64;
+            },
+        );
+    Ok(())
+}
+
 impl<D: Dim> Physics<D> for Contact {
     fn name(&self) -> &str {
         "contact"
     }
 
-    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
-        // NaN forces a build at the first step (and after a restore of an older state).
-        let mut uses = vec![CONTACT_REFERENCE.own::<D>().initial(f64::NAN)];
+    fn fields(&self, mesh: &Mesh<D>) -> Vec<FieldUse> {
+        let capacity = self.capacity_for(mesh);
+        let stride = self.law().n_state().max(1);
+        let mut uses = vec![
+            // NaN forces a build at the first step.
+            CONTACT_REFERENCE.own::<D>().initial(f64::NAN),
+            CONTACT_CANDIDATE_COUNT.own::<D>(),
+            CONTACT_CANDIDATES.own_sized::<D>(None, Some(capacity)),
+            CONTACT_HISTORY.own_sized::<D>(None, Some(capacity * stride)),
+        ];
         if let Some(b) = &self.bonds {
             // The broken-bond flags of the current step (written by the joints).
             uses.push(FieldUse {
@@ -755,21 +928,13 @@ impl<D: Dim> Physics<D> for Contact {
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
-        let model: Arc<dyn ContactModel> = match &self.custom {
-            Some(m) => m.clone(),
-            None => Arc::new(MohrCoulombContact {
-                normal_penalty: self.penalty,
-                friction: self.friction,
-                damping: self.damping,
-            }),
-        };
+        let model = self.law();
         model.check()?;
         model.check_mesh(ctx.mesh.n_elements())?;
         self.n_state = model.n_state();
         self.n_elements = ctx.mesh.n_elements();
         self.model = Some(model);
-        let (lo, _) = ctx.mesh.edge_length_range();
-        self.skin_used = self.skin.unwrap_or(0.5 * lo);
+        self.skin_used = self.skin_for(ctx.mesh);
         if !(self.skin_used > 0.0 && self.skin_used.is_finite()) {
             return Err(ComputeError::param(
                 "contact skin",
@@ -805,6 +970,21 @@ impl<D: Dim> Physics<D> for Contact {
                     format!("mesh has {nf} faces"),
                 ));
             }
+            if [
+                CONTACT_REFERENCE,
+                CONTACT_CANDIDATE_COUNT,
+                CONTACT_CANDIDATES,
+                CONTACT_HISTORY,
+            ]
+            .iter()
+            .any(|k| k.name() == b.field)
+            {
+                return Err(ComputeError::param(
+                    "contact broken-bond field",
+                    &b.field,
+                    "must be a face field of another physics, not one of contact's own",
+                ));
+            }
             let id = ctx.fields.id(&b.field)?;
             if ctx.fields.get(id).len() != nf {
                 return Err(ComputeError::param(
@@ -824,7 +1004,32 @@ impl<D: Dim> Physics<D> for Contact {
             }
             b.per_element = per;
         }
-        self.reference = Some(ctx.fields.id(CONTACT_REFERENCE)?);
+        if self.capacity == Some(0) {
+            return Err(ComputeError::param(
+                "Contact::capacity",
+                0,
+                "must be at least 1 candidate per element",
+            ));
+        }
+        let candidates = ctx.fields.id(CONTACT_CANDIDATES)?;
+        let history = ctx.fields.id(CONTACT_HISTORY)?;
+        let capacity = ctx.fields.spec(candidates).components;
+        let stride = self.n_state.max(1);
+        if ctx.fields.spec(history).components != capacity * stride {
+            return Err(ComputeError::param(
+                "contact pair history",
+                ctx.fields.spec(history).components,
+                format!("expected {capacity} candidates x {stride} values per element"),
+            ));
+        }
+        self.ids = Some(StateIds {
+            reference: ctx.fields.id(CONTACT_REFERENCE)?,
+            count: ctx.fields.id(CONTACT_CANDIDATE_COUNT)?,
+            candidates,
+            history,
+            capacity,
+            stride,
+        });
         ctx.register_slots(ctx.mesh.elements())?;
         Ok(())
     }
@@ -837,6 +1042,9 @@ impl<D: Dim> Physics<D> for Contact {
             .model
             .as_deref()
             .ok_or_else(|| ComputeError::Gpu("contact: GPU setup before init".into()))?;
+        let ids = self
+            .ids
+            .ok_or_else(|| ComputeError::Gpu("contact: GPU setup before init".into()))?;
         let input = crate::gpu::GpuContactInput {
             skin: self.skin_used,
             model,
@@ -844,23 +1052,24 @@ impl<D: Dim> Physics<D> for Contact {
                 .bonds
                 .as_ref()
                 .map(|b| (b.per_element.as_slice(), b.field.as_str())),
-            capacity: self.gpu_capacity,
-            reference: CONTACT_REFERENCE.name(),
+            capacity: ids.capacity,
+            stride: ids.stride,
         };
         crate::gpu::setup(input, setup)
     }
 
-    fn save_state(&self) -> Result<Vec<u8>, ComputeError> {
-        let cand = self.candidates.lock().map_err(|_| poisoned_state())?;
-        let slips = self.slips.lock().map_err(|_| poisoned_state())?;
-        Ok(crate::snapshot_state::encode(&cand, &slips, self.n_state))
-    }
-
-    fn restore_state(&mut self, bytes: &[u8]) -> Result<(), ComputeError> {
-        let (cand, slips) = crate::snapshot_state::decode(bytes, self.n_elements, self.n_state)?;
-        *self.candidates.get_mut().map_err(|_| poisoned_state())? = cand;
-        *self.slips.get_mut().map_err(|_| poisoned_state())? = slips;
-        Ok(())
+    fn check_fields(&self, fields: &FieldStore) -> Result<(), ComputeError> {
+        let Some(ids) = self.ids else {
+            return Ok(());
+        };
+        crate::snapshot_state::check(
+            fields.get(ids.count),
+            fields.get(ids.candidates),
+            fields.get(ids.history),
+            self.n_elements,
+            ids.capacity,
+            ids.stride,
+        )
     }
 
     fn slot_entity(&self, slot: usize) -> Option<String> {
@@ -912,13 +1121,14 @@ impl<D: Dim> Physics<D> for Contact {
     }
 
     fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
-        let rid = self.reference.expect("init ran");
+        let ids = self.ids.expect("init ran");
         let ns = self.n_state;
         let kin = &ctx.kin;
-        let reference = ctx.fields.get_mut(rid);
-        // Rebuild when any node moved more than half the skin since the last build.
+        // Rebuild when any node moved more than half the skin since the last build (a
+        // NaN reference, before the first build, always does).
         let limit2 = (0.5 * self.skin_used).powi(2);
         let dim = D::D;
+        let reference = ctx.fields.get(ids.reference);
         let moved = (0..kin.mesh.n_nodes()).any(|n| {
             let mut d2 = 0.0;
             for k in 0..dim {
@@ -927,42 +1137,40 @@ impl<D: Dim> Physics<D> for Contact {
             }
             d2.is_nan() || d2 > limit2
         });
-        let mut cand = self.candidates.lock().map_err(|_| {
-            ComputeError::physics("contact", "candidate lists poisoned by an earlier panic")
-        })?;
-        let mut slips = self.slips.lock().map_err(|_| {
-            ComputeError::physics("contact", "slip state poisoned by an earlier panic")
-        })?;
-        if moved || cand.len() != kin.mesh.n_elements() {
+        if moved {
             let fresh = ctx.backend.install(|| self.build(kin));
-            // Carry the accumulated slip of pairs that stay candidates.
-            let mut new_slips: Vec<Vec<f64>> =
-                fresh.iter().map(|l| vec![0.0; l.len() * ns]).collect();
-            if slips.len() == cand.len() {
-                for e in 0..fresh.len().min(cand.len()) {
-                    for (k, f) in fresh[e].iter().enumerate() {
-                        if let Ok(old) = cand[e].binary_search(f) {
-                            new_slips[e][k * ns..(k + 1) * ns]
-                                .copy_from_slice(&slips[e][old * ns..(old + 1) * ns]);
-                        }
-                    }
-                }
-            }
-            *cand = fresh;
-            *slips = new_slips;
+            ctx.backend
+                .install(|| store_lists(&fresh, ctx.fields, ids))?;
+            let reference = ctx.fields.get_mut(ids.reference);
             for n in 0..kin.mesh.n_nodes() {
                 for k in 0..dim {
                     reference[dim * n + k] = kin.x(n, k);
                 }
             }
         }
-        let lists = &*cand;
-        let slips: &mut Vec<Vec<f64>> = &mut slips;
+        let (cap, stride) = (ids.capacity, ids.stride);
         let model = self.model.as_deref().expect("init ran");
         let bonds = self.bonds.as_ref();
-        let broken: &[f64] = match bonds.and_then(|b| b.id) {
-            Some(id) => ctx.fields.get(id),
-            None => &[],
+        let (count, cand, hist, broken): (&[f64], &[f64], &mut [f64], &[f64]) =
+            match bonds.and_then(|b| b.id) {
+                Some(bid) => {
+                    let [n, c, h, b] =
+                        ctx.fields
+                            .get_many_mut([ids.count, ids.candidates, ids.history, bid]);
+                    (n, c, h, b)
+                }
+                None => {
+                    let [n, c, h] =
+                        ctx.fields
+                            .get_many_mut([ids.count, ids.candidates, ids.history]);
+                    (n, c, h, &[])
+                }
+            };
+        // Element e's list: the first n entries of its row (n checked on restore; the
+        // clamp keeps a hand-edited count in bounds).
+        let list = |e: usize| {
+            let n = (count[e] as usize).min(cap);
+            &cand[e * cap..e * cap + n]
         };
         if dim == 3 {
             // Tetrahedra: 4 nodes x 3 components of slots per element.
@@ -980,11 +1188,11 @@ impl<D: Dim> Physics<D> for Contact {
             ctx.backend.install(|| {
                 ctx.slots
                     .par_chunks_mut(12)
-                    .zip(slips.par_iter_mut())
+                    .zip(hist.par_chunks_mut(cap * stride))
                     .enumerate()
                     .for_each(|(e, (slot, slip))| {
                         let me = Self::element_xyz(kin, e);
-                        for (k, &f) in lists[e].iter().enumerate() {
+                        for (k, &f) in list(e).iter().enumerate() {
                             let f = f as usize;
                             if let Some(face) = bonds.and_then(|b| b.face(e, f)) {
                                 if broken[face] == 0.0 {
@@ -998,7 +1206,7 @@ impl<D: Dim> Physics<D> for Contact {
                                 (&other, &me, f, e)
                             };
                             let mut pair = tet_pair_force(c, t, model.pair_penalty(ci, ti));
-                            let state = &mut slip[k * ns..(k + 1) * ns];
+                            let state = &mut slip[k * stride..k * stride + ns];
                             if pair == PairForce3::default() {
                                 // Not touching (most candidates): no force, fresh history.
                                 model.separate(state);
@@ -1030,11 +1238,11 @@ impl<D: Dim> Physics<D> for Contact {
         ctx.backend.install(|| {
             ctx.slots
                 .par_chunks_mut(6)
-                .zip(slips.par_iter_mut())
+                .zip(hist.par_chunks_mut(cap * stride))
                 .enumerate()
                 .for_each(|(e, (slot, slip))| {
                     let me = Self::element_xy(kin, e);
-                    for (k, &f) in lists[e].iter().enumerate() {
+                    for (k, &f) in list(e).iter().enumerate() {
                         let f = f as usize;
                         // Bonded neighbours interact through their joint until it breaks.
                         if let Some(face) = bonds.and_then(|b| b.face(e, f)) {
@@ -1050,7 +1258,7 @@ impl<D: Dim> Physics<D> for Contact {
                             (&other, &me, f, e)
                         };
                         let mut pair = triangle_pair_force(c, t, model.pair_penalty(ci, ti));
-                        let state = &mut slip[k * ns..(k + 1) * ns];
+                        let state = &mut slip[k * stride..k * stride + ns];
                         if pair == PairForce2::default() {
                             // Not touching (most candidates): no force, fresh history.
                             model.separate(state);

@@ -1,180 +1,160 @@
-//! The contact physics' own snapshot state: the candidate list of every element and the
-//! pair histories, and the checks a restore makes before accepting them.
+//! The checks a restore makes on the contact physics' state fields before accepting
+//! them (the values come from a file; layout in the [`crate::physics`] module docs).
 //!
-//! Layout, little-endian: the number of lists (`u64`: 0 before the first step, else one
-//! per element), then per element its list length (`u64`), its partners (`u32` each)
-//! and `n_state` history values (`f64`) per partner.
-//!
-//! A restore accepts only what a broad-phase build can produce: one list per element
-//! (or none), every partner an element of the mesh other than the element itself, each
-//! list strictly increasing, the lists symmetric (f lists e when e lists f), exactly
-//! `n_state` values per pair and no byte left over. History values are not constrained
-//! (they index nothing; a non-finite one would stop the run through the watchdog).
+//! A restore accepts only what a broad-phase build can produce: per element a count n,
+//! an integer in `0..=capacity`; the first n candidates integers naming an element of
+//! the mesh other than the element itself, strictly increasing; the lists symmetric (f
+//! lists e when e lists f); and every candidate and history entry past the list zero.
+//! History values of listed pairs are not constrained (they index nothing; a non-finite
+//! one would stop the run through the watchdog). Reference positions are not
+//! constrained either (a NaN one forces a rebuild).
 
 use pcdc_compute::ComputeError;
-
-/// Candidate lists and pair histories, in element order.
-pub(crate) type ContactState = (Vec<Vec<u32>>, Vec<Vec<f64>>);
 
 fn corrupt(what: String) -> ComputeError {
     ComputeError::SnapshotCorrupt(format!("contact state: {what}"))
 }
 
-/// Encodes the lists and histories (a history shorter than its list is padded with 0).
-pub(crate) fn encode(cand: &[Vec<u32>], slips: &[Vec<f64>], n_state: usize) -> Vec<u8> {
-    let mut out = Vec::new();
-    out.extend_from_slice(&(cand.len() as u64).to_le_bytes());
-    let empty = Vec::new();
-    for (e, list) in cand.iter().enumerate() {
-        let slip = slips.get(e).unwrap_or(&empty);
-        out.extend_from_slice(&(list.len() as u64).to_le_bytes());
-        for f in list {
-            out.extend_from_slice(&f.to_le_bytes());
-        }
-        for k in 0..list.len() * n_state {
-            out.extend_from_slice(&slip.get(k).copied().unwrap_or(0.0).to_le_bytes());
-        }
-    }
-    out
-}
-
-/// A little-endian reader that reports running out of bytes as an error.
-struct Reader<'a> {
-    bytes: &'a [u8],
-    pos: usize,
-}
-
-impl Reader<'_> {
-    fn take<const N: usize>(&mut self) -> Result<[u8; N], ComputeError> {
-        let mut b = [0; N];
-        let s = self
-            .bytes
-            .get(self.pos..)
-            .and_then(|r| r.get(..N))
-            .ok_or_else(|| corrupt(format!("truncated at byte {}", self.pos)))?;
-        b.copy_from_slice(s);
-        self.pos += N;
-        Ok(b)
-    }
-
-    fn left(&self) -> usize {
-        self.bytes.len().saturating_sub(self.pos)
-    }
-}
-
-/// Decodes and checks a state for a mesh of `n_elements` elements and a law with
-/// `n_state` history values per pair.
-pub(crate) fn decode(
-    bytes: &[u8],
-    n_elements: usize,
-    n_state: usize,
-) -> Result<ContactState, ComputeError> {
-    let mut r = Reader { bytes, pos: 0 };
-    let count = u64::from_le_bytes(r.take()?);
-    if count != 0 && count != n_elements as u64 {
+/// The list length of element `e`, checked.
+fn count_of(count: &[f64], e: usize, capacity: usize) -> Result<usize, ComputeError> {
+    let n = count[e];
+    if !(n >= 0.0 && n <= capacity as f64 && n.fract() == 0.0) {
         return Err(corrupt(format!(
-            "{count} candidate lists for a mesh of {n_elements} elements"
+            "element {e}: candidate count {n} is not an integer in 0..={capacity}"
         )));
     }
-    let pair_bytes = 4 + 8 * n_state as u64;
-    let (mut cand, mut slips) = (Vec::new(), Vec::new());
-    for e in 0..count as usize {
-        let len = u64::from_le_bytes(r.take()?);
-        if len >= n_elements as u64 || len * pair_bytes > r.left() as u64 {
-            return Err(corrupt(format!(
-                "element {e} has {len} candidates (mesh of {n_elements} elements, {} bytes left)",
-                r.left()
-            )));
-        }
-        let mut list = Vec::with_capacity(len as usize);
-        for _ in 0..len {
-            let f = u32::from_le_bytes(r.take()?);
-            if f as usize >= n_elements || f as usize == e || list.last().is_some_and(|&l| l >= f) {
+    Ok(n as usize)
+}
+
+/// Checks the count, candidate and history fields of a mesh of `n_elements` elements,
+/// `capacity` candidates per element and `stride` history values per pair.
+pub(crate) fn check(
+    count: &[f64],
+    cand: &[f64],
+    hist: &[f64],
+    n_elements: usize,
+    capacity: usize,
+    stride: usize,
+) -> Result<(), ComputeError> {
+    if count.len() != n_elements
+        || cand.len() != n_elements * capacity
+        || hist.len() != n_elements * capacity * stride
+    {
+        return Err(corrupt(format!(
+            "{} counts, {} candidates and {} history values for {n_elements} elements of \
+             capacity {capacity} with {stride} values per pair",
+            count.len(),
+            cand.len(),
+            hist.len()
+        )));
+    }
+    for e in 0..n_elements {
+        let n = count_of(count, e, capacity)?;
+        let row = &cand[e * capacity..(e + 1) * capacity];
+        let mut last = -1.0;
+        for &f in &row[..n] {
+            if !(f >= 0.0 && f < n_elements as f64 && f.fract() == 0.0) {
                 return Err(corrupt(format!(
-                    "element {e}: candidate {f} is out of range (mesh of {n_elements} elements), the element itself, or out of order"
+                    "element {e}: candidate {f} is out of range (mesh of {n_elements} elements)"
                 )));
             }
-            list.push(f);
+            if f as usize == e {
+                return Err(corrupt(format!("element {e} lists itself as a candidate")));
+            }
+            if f <= last {
+                return Err(corrupt(format!(
+                    "element {e}: candidate {f} after {last} is out of order"
+                )));
+            }
+            last = f;
         }
-        let slip = (0..len as usize * n_state)
-            .map(|_| r.take().map(f64::from_le_bytes))
-            .collect::<Result<Vec<f64>, _>>()?;
-        cand.push(list);
-        slips.push(slip);
-    }
-    if r.left() != 0 {
-        return Err(corrupt(format!("{} bytes left over", r.left())));
-    }
-    for (e, list) in cand.iter().enumerate() {
-        if let Some(&f) = list
+        let hrow = &hist[e * capacity * stride..(e + 1) * capacity * stride];
+        if row[n..]
             .iter()
-            .find(|&&f| cand[f as usize].binary_search(&(e as u32)).is_err())
+            .chain(&hrow[n * stride..])
+            .any(|&x| x != 0.0)
         {
             return Err(corrupt(format!(
-                "element {e} lists {f} as a candidate but {f} does not list {e}"
+                "element {e}: non-zero candidate or history entry past its {n} candidates"
             )));
         }
     }
-    Ok((cand, slips))
+    for e in 0..n_elements {
+        let n = count[e] as usize;
+        for &f in &cand[e * capacity..e * capacity + n] {
+            let f = f as usize;
+            let m = count[f] as usize;
+            let other = &cand[f * capacity..f * capacity + m];
+            if other
+                .binary_search_by(|x| x.total_cmp(&(e as f64)))
+                .is_err()
+            {
+                return Err(corrupt(format!(
+                    "element {e} lists {f} as a candidate but {f} does not list {e}"
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// Three elements, all candidates of each other, two history values per pair.
-    fn lists() -> ContactState {
-        let cand = vec![vec![1, 2], vec![0, 2], vec![0, 1]];
-        let slips = cand
-            .iter()
-            .map(|l| (0..2 * l.len()).map(|k| k as f64 * 0.5).collect())
-            .collect();
-        (cand, slips)
+    /// Three elements, all candidates of each other, capacity 3, two history values per
+    /// pair: (count, candidates, history).
+    fn state() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let cand = vec![1.0, 2.0, 0.0, 0.0, 2.0, 0.0, 0.0, 1.0, 0.0];
+        let mut hist = vec![0.0; 18];
+        for e in 0..3 {
+            for k in 0..4 {
+                hist[6 * e + k] = 0.5 * (k + 1) as f64;
+            }
+        }
+        (vec![2.0; 3], cand, hist)
     }
 
     #[test]
-    fn round_trip() {
-        let (cand, slips) = lists();
-        let bytes = encode(&cand, &slips, 2);
-        assert_eq!(decode(&bytes, 3, 2).unwrap(), (cand, slips));
-        assert_eq!(decode(&encode(&[], &[], 2), 3, 2).unwrap().0.len(), 0);
+    fn valid_state_passes() {
+        let (n, c, h) = state();
+        check(&n, &c, &h, 3, 3, 2).unwrap();
+        // Before the first build: all zero.
+        check(&[0.0; 3], &[0.0; 9], &[0.0; 18], 3, 3, 2).unwrap();
     }
 
     #[test]
     fn bad_states_are_errors() {
-        let (cand, slips) = lists();
-        type Edit = fn(&mut Vec<Vec<u32>>);
-        let edits: [(&str, Edit); 4] = [
-            ("out of range", |c| c[0][1] = 7),
-            ("itself", |c| c[0][0] = 0),
-            ("order", |c| c[0] = vec![2, 1]),
-            ("does not list", |c| {
-                c[1] = vec![2];
-                c[0] = vec![1, 2];
+        type Edit = fn(&mut Vec<f64>, &mut Vec<f64>, &mut Vec<f64>);
+        let edits: [(&str, Edit); 9] = [
+            ("out of range", |_, c, _| c[1] = 7.0),
+            ("out of range", |_, c, _| c[1] = 1.5),
+            ("out of range", |_, c, _| c[1] = f64::NAN),
+            ("itself", |_, c, _| c[0] = 0.0),
+            ("order", |_, c, _| c.swap(0, 1)),
+            ("does not list", |n, c, h| {
+                n[1] = 1.0;
+                c[3] = 2.0;
+                c[4] = 0.0;
+                h[8..12].fill(0.0);
             }),
+            ("count", |n, _, _| n[2] = 4.0),
+            ("count", |n, _, _| n[2] = -1.0),
+            ("past its", |_, _, h| h[5] = 1.0),
         ];
         for (expect, edit) in edits {
-            let mut c = cand.clone();
-            edit(&mut c);
-            let e = decode(&encode(&c, &slips, 2), 3, 2)
-                .unwrap_err()
-                .to_string();
-            assert!(e.contains(expect), "{expect}: {e}");
+            let (mut n, mut c, mut h) = state();
+            edit(&mut n, &mut c, &mut h);
+            let e = check(&n, &c, &h, 3, 3, 2).unwrap_err().to_string();
+            assert!(
+                e.contains("contact state") && e.contains(expect),
+                "{expect}: {e}"
+            );
         }
-        let bytes = encode(&cand, &slips, 2);
-        // Another mesh size, another history length, truncation, extra bytes.
-        assert!(decode(&bytes, 4, 2).is_err());
-        assert!(decode(&bytes, 3, 1).is_err());
-        assert!(decode(&bytes, 3, 3).is_err());
-        for len in 0..bytes.len() {
-            assert!(decode(&bytes[..len], 3, 2).is_err(), "{len}");
-        }
-        let mut longer = bytes.clone();
-        longer.push(0);
-        assert!(decode(&longer, 3, 2).is_err());
-        // A huge list length is refused before anything is allocated.
-        let mut huge = bytes.clone();
-        huge[8..16].copy_from_slice(&u64::MAX.to_le_bytes());
-        assert!(decode(&huge, 3, 2).is_err());
+        // Wrong lengths.
+        let (n, c, h) = state();
+        assert!(check(&n, &c, &h, 3, 3, 3).is_err());
+        assert!(check(&n, &c, &h[1..], 3, 3, 2).is_err());
+        assert!(check(&n[1..], &c, &h, 3, 3, 2).is_err());
     }
 }

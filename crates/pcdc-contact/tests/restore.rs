@@ -1,8 +1,9 @@
 //! Save/restore of a frictional contact scene continues bit for bit: the candidate lists
-//! and accumulated slips travel with the snapshot.
+//! and accumulated slips are fields and travel with the snapshot (u, v and every field
+//! compared).
 
 use pcdc_compute::{Backend, Simulation};
-use pcdc_contact::Contact;
+use pcdc_contact::{Contact, CONTACT_HISTORY};
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim2, Range};
 
@@ -49,8 +50,21 @@ fn frictional_contact_restores_bit_for_bit() {
         .iter()
         .zip(&b.state.v)
         .all(|(x, y)| x.to_bits() == y.to_bits()));
+    // Every field too (reference positions, candidate lists, pair histories).
+    for spec in a.state.fields.specs() {
+        let (x, y) = (a.field(&spec.name).unwrap(), b.field(&spec.name).unwrap());
+        assert!(
+            x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits()),
+            "field {}",
+            spec.name
+        );
+    }
     // The block is still sliding mid-test (the state mattered).
     assert!(a.state.v.iter().step_by(2).any(|&v| v > 0.1));
+    // The snapshot held a friction history.
+    let mut s = scene();
+    s.restore_bytes(&snap).unwrap();
+    assert!(s.field(CONTACT_HISTORY).unwrap().iter().any(|&h| h != 0.0));
     // Truncated contact state is an error, not a panic.
     let mut c = scene();
     assert!(c.restore_bytes(&snap[..snap.len() - 3]).is_err());

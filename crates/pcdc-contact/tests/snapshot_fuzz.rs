@@ -1,7 +1,9 @@
 //! Snapshots of a fracturing FDEM scene with contact are never trusted blindly: single-bit
 //! flips spread over the whole file and truncations at many lengths are all errors,
-//! never panics; snapshots forged with a valid checksum but out-of-range, self or
-//! unordered contact candidates are errors; a snapshot of another mesh with the same
+//! never panics; snapshots forged with a valid checksum (saved from a simulation whose
+//! contact fields were edited) with out-of-range, non-integer, self or unordered
+//! candidates, a count above the capacity, an unmirrored list or a history value past a
+//! list are errors naming the contact state; a snapshot of another mesh with the same
 //! counts, or of another physics composition, is refused by name; and after all that the
 //! simulation still restores the real snapshot and continues bit for bit.
 //!
@@ -13,7 +15,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
 use pcdc_compute::{Backend, ComputeError, Simulation};
-use pcdc_contact::Contact;
+use pcdc_contact::{Contact, CONTACT_CANDIDATES, CONTACT_CANDIDATE_COUNT, CONTACT_HISTORY};
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, split_nodes, Dim2, Range};
 
@@ -75,50 +77,26 @@ fn try_restore(sim: &mut Simulation<Dim2>, bytes: &[u8]) -> Option<Result<(), Co
     catch_unwind(AssertUnwindSafe(|| sim.restore_bytes(bytes))).ok()
 }
 
-/// Position of the contact state (the last bytes of the file) and its history length
-/// per pair: the offset from which the documented layout (count = elements, then per
-/// element a length, partners and histories) ends exactly at the end of the file.
-fn contact_state(bytes: &[u8], ne: usize) -> (usize, usize) {
-    let parse = |start: usize, ns: usize| -> bool {
-        let mut pos = start + 8;
-        for _ in 0..ne {
-            let Some(len) = bytes.get(pos..pos + 8) else {
-                return false;
-            };
-            let len = u64::from_le_bytes(len.try_into().unwrap()) as usize;
-            if len >= ne {
-                return false;
-            }
-            pos += 8 + len * (4 + 8 * ns);
-        }
-        pos == bytes.len()
-    };
-    let key = (ne as u64).to_le_bytes();
-    (0..bytes.len() - 8)
-        .rev()
-        .filter(|&p| bytes[p..p + 8] == key)
-        .find_map(|p| (0..=4).find(|&ns| parse(p, ns)).map(|ns| (p, ns)))
-        .expect("contact state at the end of the snapshot")
-}
-
-/// Offset of candidate `k` of the first element with at least `k + 2` candidates, and
-/// that element.
-fn candidate(bytes: &[u8], start: usize, ns: usize, ne: usize, k: usize) -> (usize, usize) {
-    let mut pos = start + 8;
-    for e in 0..ne {
-        let len = u64::from_le_bytes(bytes[pos..pos + 8].try_into().unwrap()) as usize;
-        if len >= k + 2 {
-            return (pos + 8 + 4 * k, e);
-        }
-        pos += 8 + len * (4 + 8 * ns);
-    }
-    panic!("no element with {} candidates", k + 2);
-}
-
-/// Writes a valid checksum for the (edited) file: CRC-32 of bytes 16.. at offset 12.
-fn reseal(bytes: &mut [u8]) {
-    let crc = crc32fast::hash(&bytes[16..]);
-    bytes[12..16].copy_from_slice(&crc.to_le_bytes());
+/// A snapshot forged with a valid checksum: `snap` restored into a fresh scene, its
+/// contact fields edited by `edit(count, candidates, history, capacity)` on the first
+/// element with at least two candidates (passed as `e`), and saved again.
+fn forged(snap: &[u8], edit: impl Fn(usize, &mut [f64], &mut [f64], &mut [f64], usize)) -> Vec<u8> {
+    let mut c = scene();
+    c.restore_bytes(snap).unwrap();
+    let f = &mut c.state.fields;
+    let ids = [
+        f.id(CONTACT_CANDIDATE_COUNT).unwrap(),
+        f.id(CONTACT_CANDIDATES).unwrap(),
+        f.id(CONTACT_HISTORY).unwrap(),
+    ];
+    let cap = f.spec(ids[1]).components;
+    let [count, cand, hist] = f.get_many_mut(ids);
+    let e = count
+        .iter()
+        .position(|&n| n >= 2.0)
+        .expect("an element with two candidates");
+    edit(e, count, cand, hist, cap);
+    c.snapshot_bytes().unwrap()
 }
 
 #[test]
@@ -180,28 +158,38 @@ fn fracturing_snapshot_fuzz() {
     assert_eq!(errors, positions.len());
     assert_eq!((t_errors, t_other), (lengths.len(), 0));
 
-    // Forged with a valid checksum: a candidate out of range, the element itself, and
-    // two candidates out of order.
-    let (start, ns) = contact_state(&snap, ne);
-    let (at, e) = candidate(&snap, start, ns, ne, 0);
-    for what in ["out of range", "itself", "order"] {
-        let mut bad = snap.clone();
-        match what {
-            "out of range" => bad[at..at + 4].copy_from_slice(&(ne as u32 + 5).to_le_bytes()),
-            "itself" => bad[at..at + 4].copy_from_slice(&(e as u32).to_le_bytes()),
-            _ => {
-                // Swap the first two candidates.
-                let first: [u8; 4] = bad[at..at + 4].try_into().unwrap();
-                bad.copy_within(at + 4..at + 8, at);
-                bad[at + 4..at + 8].copy_from_slice(&first);
-            }
-        }
-        reseal(&mut bad);
+    // Forged with a valid checksum: a candidate out of range, not an integer, the
+    // element itself, two candidates out of order, a count above the capacity, a list
+    // that its partner does not mirror, and a history value past the list.
+    type Edit = fn(usize, &mut [f64], &mut [f64], &mut [f64], usize);
+    let edits: [(&str, Edit); 7] = [
+        ("out of range", |e, _, c, _, cap| c[e * cap] = 1e9),
+        ("out of range", |e, _, c, _, cap| c[e * cap] += 0.5),
+        ("itself", |e, _, c, _, cap| c[e * cap] = e as f64),
+        ("order", |e, _, c, _, cap| c.swap(e * cap, e * cap + 1)),
+        ("count", |e, n, _, _, cap| n[e] = cap as f64 + 1.0),
+        ("does not list", |e, n, c, h, cap| {
+            // Drop the element's last candidate (and its history) from its list only.
+            let (m, s) = (n[e] as usize, h.len() / n.len() / cap);
+            c[e * cap + m - 1] = 0.0;
+            h[(e * cap + m - 1) * s..(e * cap + m) * s].fill(0.0);
+            n[e] -= 1.0;
+        }),
+        ("past its", |e, n, _, h, cap| {
+            let s = h.len() / n.len() / cap;
+            h[(e * cap + n[e] as usize) * s] = 1.0;
+        }),
+    ];
+    for (what, edit) in edits {
+        let bad = forged(&snap, edit);
         let e = try_restore(&mut b, &bad)
             .unwrap_or_else(|| panic!("{what}: panic"))
             .unwrap_err()
             .to_string();
-        assert!(e.contains("contact state"), "{what}: {e}");
+        assert!(
+            e.contains("contact state") && e.contains(what),
+            "{what}: {e}"
+        );
     }
 
     // The simulation is untouched by every refused snapshot: restoring the real one and

@@ -150,7 +150,7 @@ fn header_layout_is_as_documented() {
     sim.run(5).unwrap();
     let b = sim.snapshot_bytes().unwrap();
     assert_eq!(&b[..8], b"PCDCSNAP");
-    assert_eq!(le_u32(&b, 8), 3);
+    assert_eq!(le_u32(&b, 8), SNAPSHOT_VERSION);
     assert_eq!(le_u32(&b, 12), crc32fast::hash(&b[16..]));
     let len = u64::from_le_bytes(b[16..24].try_into().unwrap());
     assert_eq!(len as usize, b.len() - SNAPSHOT_HEADER_LEN);
@@ -208,23 +208,21 @@ fn every_bit_flip_and_truncation_is_an_error() {
 fn versions_are_named() {
     let mut sim = scene();
     let mut snap = sim.snapshot_bytes().unwrap();
-    snap[8..12].copy_from_slice(&4u32.to_le_bytes());
-    let e = sim.restore_bytes(&snap).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ComputeError::SnapshotVersion {
-                found: 4,
-                supported: 3
-            }
-        ),
-        "{e}"
-    );
-    let msg = e.to_string();
-    assert!(
-        msg.contains("version 4") && msg.contains("version 3"),
-        "{msg}"
-    );
+    // The previous format (3) and a future one are named with the supported version.
+    for found in [3, SNAPSHOT_VERSION + 1] {
+        snap[8..12].copy_from_slice(&found.to_le_bytes());
+        let e = sim.restore_bytes(&snap).unwrap_err();
+        assert!(
+            matches!(e, ComputeError::SnapshotVersion { found: f, supported: SNAPSHOT_VERSION } if f == found),
+            "{e}"
+        );
+        let msg = e.to_string();
+        assert!(
+            msg.contains(&format!("version {found}"))
+                && msg.contains(&format!("version {SNAPSHOT_VERSION}")),
+            "{msg}"
+        );
+    }
     // A version-2 file: a bare postcard struct led by the text "pcdc-snapshot-2".
     let mut old = vec![15u8];
     old.extend_from_slice(b"pcdc-snapshot-2");

@@ -31,10 +31,11 @@ fn kernel(e: u32) {
         bits = bits + 1u;
     }
     atomicMax(&cell_bits[0], bits);
-    let n = ncand[e];
+    // The lists are fields of reals (exact integers).
+    let n = min(u32(ncand[e]), CAP);
     ncand_old[e] = n;
     for (var k = 0u; k < n; k = k + 1u) {
-        cand_old[e * CAP + k] = cand[e * CAP + k];
+        cand_old[e * CAP + k] = u32(cand[e * CAP + k]);
         for (var s = 0u; s < NSTATE; s = s + 1u) {
             hist_old[(e * CAP + k) * NSTATE + s] = hist[(e * CAP + k) * NSTATE + s];
         }

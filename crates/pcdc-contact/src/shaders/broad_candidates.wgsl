@@ -2,7 +2,8 @@
 // list of elements whose boxes overlap this one's and that share no node with it (the
 // same test as the CPU's `grid_candidates` / `grid_candidates_3d`), from the buckets of
 // the 3 x 3 (2D) or 3 x 3 x 3 (3D) cells around its box centre; then the pair history
-// of partners that were already candidates.
+// of partners that were already candidates, and zeros past the new list where the old
+// one was longer (the fields hold zeros past every list, as on the CPU).
 fn shares_node(e: u32, f: u32) -> bool {
     for (var a = 0u; a < NPE; a = a + 1u) {
         let n = conn[NPE * f + a];
@@ -79,7 +80,7 @@ fn kernel(e: u32) {
     let n_old = ncand_old[e];
     for (var k = 0u; k < n; k = k + 1u) {
         let f = list[k];
-        cand[e * CAP + k] = f;
+        cand[e * CAP + k] = Real(f);
         // Binary search of the partner in the old (sorted) list.
         var lo = 0u;
         var hi = n_old;
@@ -100,5 +101,11 @@ fn kernel(e: u32) {
             hist[(e * CAP + k) * NSTATE + s] = v;
         }
     }
-    ncand[e] = n;
+    for (var k = n; k < n_old; k = k + 1u) {
+        cand[e * CAP + k] = 0.0;
+        for (var s = 0u; s < NSTATE; s = s + 1u) {
+            hist[(e * CAP + k) * NSTATE + s] = 0.0;
+        }
+    }
+    ncand[e] = Real(n);
 }

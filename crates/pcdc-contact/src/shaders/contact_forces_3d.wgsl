@@ -139,9 +139,9 @@ fn is_zero(pair: PairForce) -> bool {
 fn kernel(e: u32) {
     var own: Tet;
     let me = element_xyz(e);
-    let n = ncand[e];
+    let n = min(u32(ncand[e]), CAP);
     for (var k = 0u; k < n; k = k + 1u) {
-        let f = cand[e * CAP + k];
+        let f = u32(cand[e * CAP + k]);
         // Bonded neighbours interact through their joint until it breaks.
         let face = bond_face(e, f);
         if face != 0xffffffffu {

@@ -1,9 +1,12 @@
 // The built-in law contact-m-c: the arithmetic of `MohrCoulombContact::update`, in the
 // same order. Parameters: friction on (≠ 0), tan φ, shear penalty P_t (Pa), damping on
 // (≠ 0), transition stress T (Pa), exponent b (an integer on the GPU).
-// State: accumulated slip δ_s (m), largest trial stress, stress held there (Pa).
+// State: accumulated slip δ_s (m); with damping also the largest trial stress and the
+// stress held there (Pa). Without damping the host removes the lines between the
+// DAMPING markers (the history then holds δ_s only, NSTATE = 1).
 var r: ContactStress;
 r.normal = s_try;
+// DAMPING BEGIN
 if param(p, 3u) != 0.0 {
     if s_try >= (*state)[1] {
         (*state)[1] = s_try;
@@ -19,6 +22,7 @@ if param(p, 3u) != 0.0 {
         r.normal = (*state)[2] * w;
     }
 }
+// DAMPING END
 r.shear = 0.0;
 if param(p, 0u) != 0.0 {
     (*state)[0] = (*state)[0] + dslip;

@@ -1,7 +1,7 @@
 // Contact without a contact law (table 1): contact-m-c with the pair's smaller friction
 // and penalty (shear penalty = normal penalty), no damping; the arithmetic of
 // `SurfaceContact::update_pair`, in the same order. Parameters: element count, tan φ
-// per element, penalty per element. State: accumulated slip δ_s (m) (entries 1-2 unused).
+// per element, penalty per element. State: accumulated slip δ_s (m).
 let ne = u32(param(p, 0u));
 let tan_phi = min(param(p, 1u + c), param(p, 1u + t));
 let pen = min(param(p, 1u + ne + c), param(p, 1u + ne + t));
