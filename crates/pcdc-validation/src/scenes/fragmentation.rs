@@ -23,10 +23,11 @@
 
 use std::time::Instant;
 
-use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
+use pcdc::fdem::Fdem;
+use pcdc_cohesive::IntrinsicCzmParams;
 use pcdc_compute::{Backend, Simulation};
 use pcdc_contact::Contact;
-use pcdc_mech::{Boundary, LinearElastic, Mechanics};
+use pcdc_mech::{Boundary, LinearElastic};
 use pcdc_mesh::{builders, split_nodes, Dim2, Mesh, Range};
 
 use crate::report::SceneError;
@@ -137,14 +138,10 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         penalty_overlap: 10.0 * E,
     }
     .build()?;
-    let contact = Contact::new(10.0 * E)
-        .friction(30.0, 10.0 * E)
-        .bonded_interfaces(BROKEN_FACE);
+    let contact = Contact::new(10.0 * E).friction(30.0, 10.0 * E);
     let n_joints = mesh.interfaces().len();
     let mut sim = Simulation::builder(mesh, backend.clone())
-        .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new().model(Range::All, czm))
-        .physics(contact)
+        .group(Fdem::new(rock, czm, contact))
         .physics(Boundary::new().fix(Range::group("walls")))
         .gravity([0.0, -9.81, 0.0])
         .energy_watchdog(2.0 * ENERGY_TOL)

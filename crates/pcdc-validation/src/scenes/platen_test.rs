@@ -13,13 +13,13 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use pcdc::fdem::Fdem;
 use pcdc_cohesive::{
-    czm_state, CohesiveJoints, FailureMode, IntrinsicCzm, IntrinsicCzmParams, BROKEN_FACE,
-    JOINT_DAMAGE, JOINT_STATE,
+    czm_state, FailureMode, IntrinsicCzm, IntrinsicCzmParams, JOINT_DAMAGE, JOINT_STATE,
 };
 use pcdc_compute::{Backend, BackendKind, Simulation, Table, TimeValue};
 use pcdc_contact::Contact;
-use pcdc_mech::{output, Boundary, LinearElastic, Mechanics};
+use pcdc_mech::{output, Boundary, LinearElastic};
 use pcdc_mesh::vtu::{DataArray, PvdSeries};
 use pcdc_mesh::{builders, split_nodes, Dim2, Mesh, Range};
 
@@ -621,9 +621,8 @@ pub(crate) fn run(
     }
     .model()?;
     let czm = s.joints.model(e)?;
-    let contact = Contact::new(s.contact.penalty * e)
-        .friction(s.contact.friction_deg, s.contact.penalty * e)
-        .bonded_interfaces(BROKEN_FACE);
+    let contact =
+        Contact::new(s.contact.penalty * e).friction(s.contact.friction_deg, s.contact.penalty * e);
     let v = s.loading.platen_velocity;
     let ramp = s.loading.ramp_time.max(0.0);
     let table = |sign: f64| -> Result<TimeValue, pcdc_compute::ComputeError> {
@@ -634,13 +633,7 @@ pub(crate) fn run(
         }
     };
     let mut sim = Simulation::builder(mesh, backend.clone())
-        .physics(
-            Mechanics::new()
-                .material(Range::All, rock)
-                .material(in_specimen.clone().complement(), steel),
-        )
-        .physics(CohesiveJoints::new().model(Range::All, czm))
-        .physics(contact)
+        .group(Fdem::new(rock, czm, contact).material(in_specimen.clone().complement(), steel))
         .physics(
             Boundary::new()
                 .velocity(
