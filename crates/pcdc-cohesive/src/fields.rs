@@ -34,14 +34,15 @@
 //! long as its faces stay near each other, which is what flow in an open fracture
 //! needs; once fragments have separated far they mean little.
 
+use pcdc_compute::names::JOINTS;
 use pcdc_compute::{Components, FieldKey, Place};
 
 /// Joint history, `NGAUSS × n_state` values per joint (model state per Gauss point).
 pub const JOINT_STATE: FieldKey =
-    FieldKey::new("joint_state", Place::Entities, Components::Declared);
+    FieldKey::new("joint_state", Place::Set(JOINTS), Components::Declared);
 /// Largest damage D over the joint's Gauss points (1 value per joint; 1 = broken).
 pub const JOINT_DAMAGE: FieldKey =
-    FieldKey::new("joint_damage", Place::Entities, Components::Fixed(1));
+    FieldKey::new("joint_damage", Place::Set(JOINTS), Components::Fixed(1));
 /// Face field: 1 on both faces of a broken joint, else 0 (what contact reads).
 pub const BROKEN_FACE: FieldKey = FieldKey::new("broken_face", Place::Face, Components::Fixed(1));
 // The joint kinematics are read by physics that must not depend on this crate (fluid

@@ -47,11 +47,14 @@ const JOINT_LIBRARY: &str = include_str!("shaders/joint_library.wgsl");
 
 const CHUNK: usize = 256;
 
-/// Declares a per-joint field this physics owns: one value set per joint (interface) of
-/// the mesh, `components` values each (`None`: the key's). The one place to change when
-/// joints become a named entity set.
-fn own_per_joint<D: Dim>(key: FieldKey, n_joints: usize, components: Option<usize>) -> FieldUse {
-    key.own_sized::<D>(Some(n_joints), components)
+/// Declares a per-joint field this physics owns: one value set per joint of the entity
+/// set `names::JOINTS` (the mesh's interfaces), `components` values each (`None`: the
+/// key's).
+fn own_per_joint<D: Dim>(key: FieldKey, _n_joints: usize, components: Option<usize>) -> FieldUse {
+    match components {
+        Some(c) => key.own_sized::<D>(c),
+        None => key.own::<D>(),
+    }
 }
 
 /// Where [`CohesiveJoints::joint`] writes joint `j`'s published kinematics.

@@ -19,6 +19,11 @@ use crate::ComputeError;
 pub mod names {
     use super::{Components, FieldKey, Place};
 
+    /// The entity set of the mesh's interfaces (face-joints made by
+    /// `pcdc_mesh::split_nodes`, in the order of `Mesh::interfaces`; empty on an
+    /// unsplit mesh), each entity joining the nodes of its two faces.
+    pub const JOINTS: &str = "joints";
+
     /// Element Cauchy stress (Pa), symmetric tensor, stride NSYM. Owner: mechanics.
     pub const STRESS: FieldKey = FieldKey::new("stress", Place::Element, Components::Sym);
     /// Element out-of-plane stress σzz in plane strain (Pa), 2D only. Owner: mechanics.
@@ -38,19 +43,18 @@ pub mod names {
     /// (`pcdc_mesh::Mesh::interfaces`): o = δ̄·n (m), δ̄ the mean gap of the node pairs,
     /// n the unit normal below; positive when open. Owner: cohesive joints.
     pub const JOINT_OPENING: FieldKey =
-        FieldKey::new("joint_opening", Place::Entities, Components::Fixed(1));
+        FieldKey::new("joint_opening", Place::Set(JOINTS), Components::Fixed(1));
     /// Sliding of each joint: s = δ̄ − o n (m), a vector in global axes orthogonal to the
     /// normal (|s| is the sliding distance). Owner: cohesive joints.
     pub const JOINT_SLIDING: FieldKey =
-        FieldKey::new("joint_sliding", Place::Entities, Components::Vector);
+        FieldKey::new("joint_sliding", Place::Set(JOINTS), Components::Vector);
     /// Unit normal of each joint's midplane, from side A to side B of its interface.
     /// Owner: cohesive joints.
     pub const JOINT_NORMAL: FieldKey =
-        FieldKey::new("joint_normal", Place::Entities, Components::Vector);
+        FieldKey::new("joint_normal", Place::Set(JOINTS), Components::Vector);
 }
 
-/// Where a field key lives (the entity count of [`Place::Entities`] is given by the
-/// owner when it declares the field).
+/// Where a field key lives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Place {
     /// One value set per mesh node.
@@ -59,8 +63,10 @@ pub enum Place {
     Element,
     /// One value set per face.
     Face,
-    /// One value set per entity of a physics-defined set (e.g. joints).
-    Entities,
+    /// One value set per entity of a named entity set ([`crate::EntitySet`]): the mesh's
+    /// interfaces are [`names::JOINTS`]; a physics declares its own sets with
+    /// [`crate::Physics::entity_sets`].
+    Set(&'static str),
 }
 
 /// Values per entity of a field key.
@@ -127,7 +133,6 @@ impl FieldKey {
         FieldUse {
             name: self.name.to_string(),
             place: Some(self.place),
-            entities: None,
             components: self.components.resolve::<D>(),
             initial: 0.0,
             access,
@@ -135,20 +140,17 @@ impl FieldKey {
     }
 
     /// This physics owns the field: it declares it (allocated, initial value 0), writes
-    /// it, and is the only one that may own it. For [`Place::Entities`] or
-    /// [`Components::Declared`] keys use [`FieldKey::own_sized`].
+    /// it, and is the only one that may own it. For [`Components::Declared`] keys use
+    /// [`FieldKey::own_sized`].
     pub fn own<D: Dim>(self) -> FieldUse {
         self.usage::<D>(FieldAccess::Own)
     }
 
-    /// Owns a field whose entity count ([`Place::Entities`]) or component count
-    /// ([`Components::Declared`]) only the owner knows.
-    pub fn own_sized<D: Dim>(self, entities: Option<usize>, components: Option<usize>) -> FieldUse {
+    /// Owns a field whose component count only the owner knows (e.g.
+    /// [`Components::Declared`]: model state variables).
+    pub fn own_sized<D: Dim>(self, components: usize) -> FieldUse {
         let mut u = self.usage::<D>(FieldAccess::Own);
-        u.entities = entities;
-        if components.is_some() {
-            u.components = components;
-        }
+        u.components = Some(components);
         u
     }
 
@@ -216,8 +218,6 @@ pub struct FieldUse {
     pub name: String,
     /// Where it lives (`None`: not checked, for a field named at run time).
     pub place: Option<Place>,
-    /// Entity count of a [`Place::Entities`] field (owner only).
-    pub entities: Option<usize>,
     /// Values per entity (`None`: not checked, or not yet known).
     pub components: Option<usize>,
     /// Initial value of every component (owner only).
@@ -233,7 +233,6 @@ impl FieldUse {
         FieldUse {
             name: name.to_string(),
             place: None,
-            entities: None,
             components: None,
             initial: 0.0,
             access,
@@ -246,8 +245,12 @@ impl FieldUse {
         self
     }
 
-    /// The declaration of an owned field, with the entity counts of `mesh`.
-    pub(crate) fn spec<D: Dim>(&self, mesh: &Mesh<D>) -> Result<(FieldSpec, usize), ComputeError> {
+    /// The declaration of an owned field, with the entity counts of `mesh` and `sets`.
+    pub(crate) fn spec<D: Dim>(
+        &self,
+        mesh: &Mesh<D>,
+        sets: &[crate::EntitySet],
+    ) -> Result<(FieldSpec, usize), ComputeError> {
         let missing = |what: &str| {
             ComputeError::param(
                 format!("field '{}'", self.name),
@@ -260,9 +263,15 @@ impl FieldUse {
             Place::Node => (Location::Node, mesh.n_nodes()),
             Place::Element => (Location::Element, mesh.n_elements()),
             Place::Face => (Location::Face, mesh.faces().len()),
-            Place::Entities => {
-                let n = self.entities.ok_or_else(|| missing("entity count"))?;
-                (Location::Entities(n), n)
+            Place::Set(name) => {
+                let set = sets.iter().find(|s| s.name() == name).ok_or_else(|| {
+                    ComputeError::param(
+                        format!("field '{}'", self.name),
+                        name,
+                        "no entity set of that name: the mesh's interfaces are 'joints' (after split_nodes); physics declare theirs with Physics::entity_sets",
+                    )
+                })?;
+                (Location::Entities(set.len()), set.len())
             }
         };
         Ok((
@@ -286,7 +295,7 @@ pub enum Location {
     Element,
     /// One value set per face.
     Face,
-    /// One value set per entity of a physics-defined set of the given size (e.g. joints).
+    /// One value set per entity of a named entity set ([`Place::Set`]) of the given size.
     Entities(usize),
 }
 

@@ -24,6 +24,7 @@
 
 mod backend;
 mod energy;
+mod entity_set;
 mod error;
 mod field;
 mod fingerprint;
@@ -38,6 +39,7 @@ mod table;
 
 pub use backend::{Backend, BackendChoice, BackendKind, CpuBackend, Precision};
 pub use energy::{EnergyBalance, PhysicsEnergy, ENERGY_CHECK_EVERY};
+pub use entity_set::EntitySet;
 pub use error::ComputeError;
 pub use field::{
     names, Components, FieldAccess, FieldId, FieldKey, FieldSpec, FieldStore, FieldUse, Location,

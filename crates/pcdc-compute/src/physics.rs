@@ -192,6 +192,8 @@ pub struct InitContext<'a, D: Dim> {
     /// Field storage (already holding every declared field).
     pub fields: &'a mut FieldStore,
     pub(crate) slot_nodes: Vec<u32>,
+    /// The simulation's entity sets.
+    pub(crate) sets: &'a [crate::EntitySet],
     /// Nodes in the simulation before this physics' `add_nodes` calls.
     pub(crate) n_nodes: usize,
     /// Reference coordinates and masses of the nodes this physics adds.
@@ -219,6 +221,11 @@ impl<D: Dim> InitContext<'_, D> {
             first,
             len: nodes.len(),
         })
+    }
+
+    /// The entity set named `name` (e.g. [`crate::names::JOINTS`]).
+    pub fn entity_set(&self, name: &str) -> Option<&crate::EntitySet> {
+        self.sets.iter().find(|s| s.name() == name)
     }
 
     /// Nodes in the simulation so far: the mesh nodes and every node added up to now.
@@ -332,6 +339,14 @@ pub trait Physics<D: Dim>: Send + Sync {
     /// [`Physics::init`]; the builder checks that every field has exactly one owner and
     /// that a reader of the current step's value runs after the field's writers.
     fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
+        Vec::new()
+    }
+
+    /// Entity sets this physics defines (e.g. flow channels, bolt segments), available to
+    /// every physics' fields ([`crate::Place::Set`]) and at init
+    /// ([`InitContext::entity_set`]). The mesh's interfaces are always the set
+    /// [`crate::names::JOINTS`]. Default: none.
+    fn entity_sets(&self, _mesh: &Mesh<D>) -> Vec<crate::EntitySet> {
         Vec::new()
     }
 

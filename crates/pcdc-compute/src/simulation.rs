@@ -238,6 +238,7 @@ impl<D: Dim> SimulationBuilder<D> {
             gpu: None,
             device_fresh: false,
             coords: layout.coords.clone(),
+            sets: layout.sets.clone(),
             mesh,
             backend,
             physics,
@@ -272,6 +273,8 @@ impl<D: Dim> SimulationBuilder<D> {
 
 /// Fields, slots and the node -> slot gather lists of a composition.
 pub(crate) struct Layout {
+    /// The entity sets: the mesh's interfaces, then the physics' own.
+    pub sets: Vec<crate::EntitySet>,
     /// Reference coordinates of every node: the mesh's, then the added ones.
     pub coords: Vec<f64>,
     /// Masses of the nodes physics added (kg).
@@ -283,12 +286,47 @@ pub(crate) struct Layout {
     pub gather_idx: Vec<u32>,
 }
 
+/// The mesh's interfaces as the set [`crate::names::JOINTS`], then every physics' own
+/// sets (names unique; node indices within the mesh).
+fn entity_sets<D: Dim>(
+    mesh: &Mesh<D>,
+    physics: &[Box<dyn Physics<D>>],
+) -> Result<Vec<crate::EntitySet>, ComputeError> {
+    let joints = mesh.interfaces();
+    let mut sets = vec![crate::EntitySet::new(
+        crate::names::JOINTS,
+        joints.nodes_per_joint().max(1),
+        joints.nodes().to_vec(),
+    )?];
+    for p in physics {
+        for s in p.entity_sets(mesh) {
+            if sets.iter().any(|t| t.name() == s.name()) {
+                return Err(ComputeError::param(
+                    format!("entity set of physics '{}'", p.name()),
+                    s.name(),
+                    "another set has that name",
+                ));
+            }
+            if let Some(&n) = s.nodes().iter().find(|&&n| n as usize >= mesh.n_nodes()) {
+                return Err(ComputeError::param(
+                    format!("entity set '{}' of physics '{}'", s.name(), p.name()),
+                    n,
+                    format!("the mesh has {} nodes", mesh.n_nodes()),
+                ));
+            }
+            sets.push(s);
+        }
+    }
+    Ok(sets)
+}
+
 /// Checks the composition's field uses (one owner per field, no use without an owner,
 /// readers after writers, unique physics once) and declares the owned fields in the
 /// order of their owners.
 fn declare_fields<D: Dim>(
     mesh: &Mesh<D>,
     physics: &[Box<dyn Physics<D>>],
+    sets: &[crate::EntitySet],
 ) -> Result<FieldStore, ComputeError> {
     for (i, p) in physics.iter().enumerate() {
         if p.unique() && physics[..i].iter().any(|q| q.name() == p.name()) {
@@ -308,7 +346,7 @@ fn declare_fields<D: Dim>(
                 });
             }
             owner.insert(&u.name, i);
-            let (spec, count) = u.spec(mesh)?;
+            let (spec, count) = u.spec(mesh, sets)?;
             fields.declare(spec, count)?;
         }
     }
@@ -328,7 +366,7 @@ fn declare_fields<D: Dim>(
                     (crate::Place::Node, crate::Location::Node)
                         | (crate::Place::Element, crate::Location::Element)
                         | (crate::Place::Face, crate::Location::Face)
-                        | (crate::Place::Entities, crate::Location::Entities(_))
+                        | (crate::Place::Set(_), crate::Location::Entities(_))
                 )
             });
             if !place_ok || u.components.is_some_and(|c| c != spec.components) {
@@ -376,8 +414,8 @@ pub(crate) fn prepare_layout<D: Dim>(
     mesh: &Mesh<D>,
     physics: &mut [Box<dyn Physics<D>>],
 ) -> Result<Layout, ComputeError> {
-    let fields = declare_fields(mesh, physics)?;
-    let mut fields = fields;
+    let sets = entity_sets(mesh, physics)?;
+    let mut fields = declare_fields(mesh, physics, &sets)?;
     let mut slot_ranges = Vec::with_capacity(physics.len());
     let mut slot_nodes = Vec::new();
     let mut coords = mesh.coords().to_vec();
@@ -387,6 +425,7 @@ pub(crate) fn prepare_layout<D: Dim>(
             mesh,
             fields: &mut fields,
             slot_nodes: Vec::new(),
+            sets: &sets,
             n_nodes: coords.len() / D::D,
             added_coords: Vec::new(),
             added_mass: Vec::new(),
@@ -413,6 +452,7 @@ pub(crate) fn prepare_layout<D: Dim>(
         fill[n as usize] += 1;
     }
     Ok(Layout {
+        sets,
         coords,
         added_mass,
         fields,
@@ -430,6 +470,8 @@ pub struct Simulation<D: Dim> {
     pub(crate) mesh: Mesh<D>,
     /// Reference coordinates of every node (mesh nodes, then added ones), stride D.
     pub(crate) coords: Vec<f64>,
+    /// Entity sets (the mesh's interfaces first).
+    pub(crate) sets: Vec<crate::EntitySet>,
     pub(crate) backend: Backend,
     pub(crate) physics: Vec<Box<dyn Physics<D>>>,
     pub(crate) mass: Vec<f64>,
@@ -817,6 +859,12 @@ impl<D: Dim> Simulation<D> {
             .iter()
             .map(|p| p.stored_energy(&kin, &self.state.fields))
             .sum()
+    }
+
+    /// The entity set named `name` (e.g. [`crate::names::JOINTS`]: the mesh's
+    /// interfaces), with its node connectivity.
+    pub fn entity_set(&self, name: &str) -> Option<&crate::EntitySet> {
+        self.sets.iter().find(|s| s.name() == name)
     }
 
     /// Number of nodes integrated: the mesh nodes, then the nodes physics added

@@ -913,8 +913,8 @@ impl<D: Dim> Physics<D> for Contact {
             // NaN forces a build at the first step.
             CONTACT_REFERENCE.own::<D>().initial(f64::NAN),
             CONTACT_CANDIDATE_COUNT.own::<D>(),
-            CONTACT_CANDIDATES.own_sized::<D>(None, Some(capacity)),
-            CONTACT_HISTORY.own_sized::<D>(None, Some(capacity * stride)),
+            CONTACT_CANDIDATES.own_sized::<D>(capacity),
+            CONTACT_HISTORY.own_sized::<D>(capacity * stride),
         ];
         if let Some(b) = &self.bonds {
             // The broken-bond flags of the current step (written by the joints).

@@ -511,13 +511,13 @@ impl<D: Dim> Physics<D> for Mechanics {
         let extra = if D::D == 2 {
             names::STRESS_ZZ.own::<D>()
         } else {
-            names::ROTATION.own_sized::<D>(None, Some(9))
+            names::ROTATION.own_sized::<D>(9)
         };
         vec![
             names::STRESS.own::<D>(),
             names::STRAIN.own::<D>(),
             extra,
-            names::MODEL_STATE.own_sized::<D>(None, Some(n_state.max(1))),
+            names::MODEL_STATE.own_sized::<D>(n_state.max(1)),
             crate::actions::DISPLACEMENT_RESET.own::<D>(),
         ]
     }
