@@ -110,9 +110,13 @@ fn bench(c: &mut Criterion) {
                 let boxes = pcdc_contact::element_boxes(&kin, 0.25 * lo);
                 let lists = pcdc_contact::grid_candidates(&boxes, sim.mesh().elements());
                 let evals: usize = lists.iter().map(|l| l.len()).sum();
+                // The contact state (lists and histories) is in fields of a fixed
+                // capacity per element, so it counts in the simulation state.
+                let cap = sim.field(pcdc_contact::CONTACT_CANDIDATES).unwrap().len() / n;
                 eprintln!(
-                    "fdem_step contact: {n} triangles, {:.2} candidate pairs per triangle-step, bonded ones (~3) skipped (pairs/s = triangle-steps/s x this)",
-                    evals as f64 / n as f64
+                    "fdem_step contact: {n} triangles, {:.2} candidate pairs per triangle-step, bonded ones (~3) skipped (pairs/s = triangle-steps/s x this); capacity {cap} candidates per triangle, {:.0} B per triangle in the simulation state",
+                    evals as f64 / n as f64,
+                    sim.state_bytes() as f64 / n as f64
                 );
             }
             g.throughput(Throughput::Elements(n as u64));

@@ -1,5 +1,5 @@
 //! Contact: laws (penalties, friction, damping, surface properties), the broad phase's
-//! skin, the GPU candidate capacity and bonded pairs; each is an error naming the
+//! skin, the candidate capacity and bonded pairs; each is an error naming the
 //! parameter when the simulation is built.
 
 use pcdc_compute::{
@@ -126,6 +126,14 @@ fn bad_contact_is_a_named_error() {
             case("bonded face out of range", "contact bonded face", || {
                 build(Contact::new(E).bonded_pairs(&[0, 1], &[9999], "broken_face"))
             }),
+            case("zero candidate capacity", "Contact::capacity", || {
+                build(Contact::new(E).capacity(0))
+            }),
+            case(
+                "broken-bond field is one of contact's own",
+                "contact_candidate_count",
+                || build(Contact::new(E).bonded_pairs(&[0, 1], &[0], "contact_candidate_count")),
+            ),
             case(
                 "broken-bond field nobody owns",
                 "reads field 'no_such_field', but no composed physics owns it",
