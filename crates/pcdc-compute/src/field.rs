@@ -52,6 +52,16 @@ pub mod names {
     /// Owner: cohesive joints.
     pub const JOINT_NORMAL: FieldKey =
         FieldKey::new("joint_normal", Place::Set(JOINTS), Components::Vector);
+    /// Node temperature T (K), one value per node. Owner: the thermal physics (the
+    /// future `pcdc-thermal`). Constitutive and joint models read it as a coupling
+    /// input (e.g. thermal strain α ΔT).
+    pub const TEMPERATURE: FieldKey =
+        FieldKey::new("temperature", Place::Node, Components::Fixed(1));
+    /// Node pore (fluid) pressure p (Pa, compression positive), one value per node.
+    /// Owner: the fluid physics (the future `pcdc-hydro`). Constitutive and joint models
+    /// read it as a coupling input (e.g. effective stress σ' = σ + b p I).
+    pub const PORE_PRESSURE: FieldKey =
+        FieldKey::new("pore_pressure", Place::Node, Components::Fixed(1));
 }
 
 /// Where a field key lives.
