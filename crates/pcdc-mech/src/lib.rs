@@ -22,7 +22,7 @@
 //! | --- | --- | --- |
 //! | 7.1 i–v | explicit central differences `v += dt F/m`, `u += dt v` | `pcdc_compute::Simulation` |
 //! | eq. 1–11 | constant element strain; here its large-rotation form: `F = D_s D_m⁻¹`, `F = R U`, `ε = U − I` | [`kinematics`] |
-//! | eq. 12 | `σ(t+Δt) = H(σ(t), ε, Δε, history)` | [`ConstitutiveModel::update`] |
+//! | eq. 12 | `σ(t+Δt) = H(σ(t), ε, Δε, history)` (and coupling inputs) | [`ConstitutiveModel::update`], [`ConstitutiveModel::update_with`] |
 //! | eq. 13–14 | nodal forces from the element stress, `f_a = −V₀ R σ ∇N_a` | `Mechanics` |
 //! | eq. 15–16 | body force and lumped mass `ρV/(N+1)` per node | `Mechanics`, gravity in `Simulation` |
 //! | eq. 17–19 | viscous stress `σ_v = D_f C ε̇`, `C = 2L√(ρE)`, L = mean edge length | `Mechanics` |
@@ -49,6 +49,71 @@
 //! sim.run(10).unwrap();
 //! ```
 
+//!
+//! ## Coupling inputs for plugin models
+//!
+//! A [`ConstitutiveModel`] that depends on another physics' field (temperature for a
+//! thermal strain, pore pressure for effective stress) names the fields in
+//! [`ConstitutiveModel::coupling`] (well-known keys: `pcdc_compute::names::TEMPERATURE`,
+//! K, and `names::PORE_PRESSURE`, Pa, both node fields) and overrides
+//! [`ConstitutiveModel::update_with`], whose [`ModelInput::coupling`] holds the fields'
+//! values at the element in declaration order (node field: mean of the element's node
+//! values; element field: the element's value). [`Mechanics`] then reads those fields
+//! (lagged: the value they hold when its forces stage runs, at most one step old, so the
+//! owner may be composed before or after it); the physics that owns them must be
+//! composed too, or the build fails with
+//! [`pcdc_compute::ComputeError::FieldWithoutOwner`]. On the GPU the model's WGSL body
+//! receives the same values as `coupling[i]` ([`WgslModel`]). A model that asks for
+//! nothing costs nothing: no field is declared or allocated, nothing is gathered and
+//! the element kernel is unchanged.
+//!
+//! ```
+//! use pcdc_compute::{names, FieldKey};
+//! use pcdc_mech::{ConstitutiveModel, LinearElastic, ModelInput, Sym6};
+//!
+//! /// Thermo-elasticity, incremental: σ += C:Δε − 3Kα ΔT I, with the temperature of the
+//! /// previous update kept as history variable 0 (initially T0).
+//! #[derive(Debug)]
+//! struct ThermoElastic {
+//!     elastic: LinearElastic,
+//!     /// Linear expansion coefficient α (1/K).
+//!     alpha: f64,
+//!     /// Reference temperature T0 (K).
+//!     t0: f64,
+//! }
+//!
+//! impl ConstitutiveModel for ThermoElastic {
+//!     fn name(&self) -> &str { "thermo-elastic" }
+//!     fn density(&self) -> f64 { self.elastic.density() }
+//!     fn young(&self) -> f64 { self.elastic.young() }
+//!     fn wave_modulus(&self) -> f64 { self.elastic.wave_modulus() }
+//!     fn damp_factor(&self) -> f64 { self.elastic.damp_factor() }
+//!     fn n_state(&self) -> usize { 1 }
+//!     fn init_state_into(&self, state: &mut [f64]) { state[0] = self.t0; }
+//!     fn coupling(&self) -> &[FieldKey] { &[names::TEMPERATURE] }
+//!     /// Without coupling inputs: the temperature stays at T0.
+//!     fn update(&self, strain: &Sym6, dstrain: &Sym6, stress: &mut Sym6, state: &mut [f64]) {
+//!         self.elastic.update(strain, dstrain, stress, state);
+//!     }
+//!     fn update_with(&self, input: &ModelInput<'_>, stress: &mut Sym6, state: &mut [f64]) {
+//!         let t = input.coupling[0];
+//!         let th = 3.0 * self.elastic.bulk() * self.alpha * (t - state[0]);
+//!         state[0] = t;
+//!         let ds = self.elastic.stress_of(input.dstrain);
+//!         for k in 0..6 {
+//!             stress[k] += ds[k] - if k < 3 { th } else { 0.0 };
+//!         }
+//!     }
+//! }
+//!
+//! let m = ThermoElastic { elastic: LinearElastic::new(30e9, 0.25, 2600.0)?, alpha: 1e-5, t0: 293.15 };
+//! let (mut stress, mut state) = ([0.0; 6], [293.15]);
+//! // Clamped (no strain), heated by 100 K: σ = −3Kα ΔT = −E α ΔT / (1 − 2ν) = −60 MPa.
+//! m.update_with(&ModelInput::new(&[0.0; 6], &[0.0; 6], &[393.15]), &mut stress, &mut state);
+//! assert!((stress[0] + 60e6).abs() < 1e-6 * 60e6);
+//! # Ok::<(), pcdc_mech::MechError>(())
+//! ```
+
 #![warn(missing_docs)]
 // Index loops mirror the tensor notation of the manual's equations.
 #![allow(clippy::needless_range_loop)]
@@ -65,4 +130,4 @@ pub use actions::{reset_displacement, reset_element_state, reset_velocity, set_v
 pub use boundary::{Boundary, Components, Constraint, FaceStress, ACCEL_VELOCITY};
 pub use error::MechError;
 pub use mechanics::{Mechanics, SurfaceProperties};
-pub use model::{double_dot, ConstitutiveModel, LinearElastic, Sym6, WgslModel};
+pub use model::{double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};

@@ -6,22 +6,25 @@
 //! Fields: `stress` (co-rotated Cauchy stress, Pa, stride NSYM), `strain` (co-rotated
 //! strain, stride NSYM), in 2D `stress_zz` (plane-strain σ_zz), in 3D `rotation` (the
 //! element rotation R, 9 values row-major), and `model_state` when a model has history
-//! variables.
+//! variables. It reads (lagged) the coupling fields its models ask for
+//! ([`ConstitutiveModel::coupling`]) and passes each model their values at the element
+//! ([`crate::ModelInput::coupling`]); when no model asks, it declares and gathers
+//! nothing.
 
 use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase};
-use pcdc_compute::FieldUse;
 use pcdc_compute::{
     names, ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics,
     Physics, StableStep,
 };
+use pcdc_compute::{Backend, FieldKey, FieldUse, Location};
 use pcdc_compute::{Entity, EntityKind};
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
 use crate::kinematics::{dm_inv_2d, polar_2d_h, polar_3d};
-use crate::model::{double_dot, ConstitutiveModel, Sym6};
+use crate::model::{double_dot, ConstitutiveModel, ModelInput, Sym6};
 use crate::MechError;
 
 const CHUNK: usize = 256;
@@ -74,6 +77,50 @@ pub struct Mechanics {
     n_state: usize,
     geo: ElementGeometry,
     ids: Option<Ids>,
+    coupling: Coupling,
+}
+
+/// One coupling field read by the models, as found in the field store at init.
+#[derive(Clone, Copy, Debug)]
+struct CouplingField {
+    id: FieldId,
+    /// A node field (interpolated: mean of the element's nodes); else an element field.
+    node: bool,
+    /// Values per entity.
+    components: usize,
+}
+
+/// The coupling inputs of the models (all empty when no model declares any).
+#[derive(Clone, Debug, Default)]
+struct Coupling {
+    /// The keys the models declare, each once, in order of first declaration.
+    keys: Vec<FieldKey>,
+    /// The fields of `keys`, after init.
+    fields: Vec<CouplingField>,
+    /// Per model: indices into `fields` of its keys, in its declaration order.
+    of_model: Vec<Vec<usize>>,
+    /// Per model: its number of coupling values (the components of its keys).
+    len_of_model: Vec<usize>,
+    /// Values per element in `values`: the largest of `len_of_model` (0: no coupling).
+    stride: usize,
+    /// Each element's values in its model's order, `stride` per element, refreshed at
+    /// the start of every force evaluation (scratch, not state).
+    values: Vec<f64>,
+}
+
+/// The coupling keys the models declare, each once, in order of first declaration.
+fn coupling_keys<'a>(
+    models: impl Iterator<Item = &'a Arc<dyn ConstitutiveModel>>,
+) -> Vec<FieldKey> {
+    let mut keys: Vec<FieldKey> = Vec::new();
+    for m in models {
+        for k in m.coupling() {
+            if !keys.contains(k) {
+                keys.push(*k);
+            }
+        }
+    }
+    keys
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -181,6 +228,185 @@ impl Mechanics {
 
     fn ids(&self) -> Ids {
         self.ids.expect("Mechanics used before init")
+    }
+
+    /// The coupling inputs of the resolved models: the fields they read (node or element
+    /// fields, declared by their owners), each model's indices and value count, and the
+    /// value buffer (allocated only when a model reads a field).
+    fn resolve_coupling(&self, fields: &FieldStore, ne: usize) -> Result<Coupling, ComputeError> {
+        let keys = coupling_keys(self.models.iter());
+        if keys.is_empty() {
+            return Ok(Coupling::default());
+        }
+        let mut resolved = Vec::with_capacity(keys.len());
+        for k in &keys {
+            let id = fields.id(k)?;
+            let spec = fields.spec(id);
+            let node = match spec.location {
+                Location::Node => true,
+                Location::Element => false,
+                other => {
+                    let model = self
+                        .models
+                        .iter()
+                        .find(|m| m.coupling().contains(k))
+                        .map_or("?", |m| m.name());
+                    return Err(ComputeError::param(
+                        format!("coupling field '{k}' of constitutive model '{model}'"),
+                        format!("{other:?}"),
+                        "a model reads node or element fields only",
+                    ));
+                }
+            };
+            resolved.push(CouplingField {
+                id,
+                node,
+                components: spec.components,
+            });
+        }
+        let of_model: Vec<Vec<usize>> = self
+            .models
+            .iter()
+            .map(|m| {
+                m.coupling()
+                    .iter()
+                    .filter_map(|k| keys.iter().position(|u| u == k))
+                    .collect()
+            })
+            .collect();
+        let len_of_model: Vec<usize> = of_model
+            .iter()
+            .map(|ix| ix.iter().map(|&i| resolved[i].components).sum())
+            .collect();
+        let stride = len_of_model.iter().copied().max().unwrap_or(0);
+        Ok(Coupling {
+            keys,
+            fields: resolved,
+            of_model,
+            len_of_model,
+            stride,
+            values: vec![0.0; ne * stride],
+        })
+    }
+
+    /// The WGSL of the coupling inputs (only with coupling): the `Coupling` alias and
+    /// `coupling_of(e, mat)`, which computes every coupling field's values at element
+    /// `e` (the operations of [`Self::gather_coupling`]) and returns those of material
+    /// `mat`'s model in its order (zero beyond its count), through the table
+    /// `mat_coupling` ([`Self::bind_coupling`]).
+    fn coupling_wgsl<D: Dim>(&self) -> String {
+        let npe = D::NODES_PER_ELEM;
+        let total: usize = self.coupling.fields.iter().map(|f| f.components).sum();
+        let mut src = format!(
+            "alias Coupling = array<Real, {}u>;\nfn coupling_of(e: u32, mat: u32) -> Coupling {{\n    var all: array<Real, {total}u>;\n",
+            self.coupling.stride
+        );
+        let mut at = 0;
+        for (i, f) in self.coupling.fields.iter().enumerate() {
+            let nc = f.components;
+            src.push_str(&format!(
+                "    // '{}'\n    for (var c = 0u; c < {nc}u; c = c + 1u) {{\n",
+                self.coupling.keys[i]
+            ));
+            if f.node {
+                src.push_str(&format!(
+                    "        var sum = Real(0.0);\n        for (var a = 0u; a < {npe}u; a = a + 1u) {{\n            sum = sum + cpl{i}[conn[{npe}u * e + a] * {nc}u + c];\n        }}\n        all[{at}u + c] = sum / Real({npe}.0);\n"
+                ));
+            } else {
+                src.push_str(&format!(
+                    "        all[{at}u + c] = cpl{i}[e * {nc}u + c];\n"
+                ));
+            }
+            src.push_str("    }\n");
+            at += nc;
+        }
+        src.push_str(
+            "    var out: Coupling;\n    let n = mat_coupling[2u * mat];\n    let o = mat_coupling[2u * mat + 1u];\n    for (var k = 0u; k < n; k = k + 1u) {\n        out[k] = all[mat_coupling[o + k]];\n    }\n    return out;\n}\n",
+        );
+        src
+    }
+
+    /// Binds the coupling fields (`cpl0`, `cpl1`, ... in the order of
+    /// [`Coupling::keys`], read only) and the table `mat_coupling`: per material its
+    /// value count and the offset of its map, then the maps (per value, its index in
+    /// `coupling_of`'s `all`).
+    fn bind_coupling<D: Dim>(
+        &self,
+        setup: &mut GpuSetup<'_, D>,
+        mut kernel: Kernel,
+    ) -> Result<Kernel, ComputeError> {
+        let mut first = Vec::with_capacity(self.coupling.fields.len());
+        let mut at = 0u32;
+        for f in &self.coupling.fields {
+            first.push(at);
+            at += f.components as u32;
+        }
+        let nm = self.models.len();
+        let mut table: Vec<u32> = Vec::with_capacity(2 * nm);
+        let mut maps: Vec<u32> = Vec::new();
+        for (m, ix) in self.coupling.of_model.iter().enumerate() {
+            table.push(self.coupling.len_of_model[m] as u32);
+            table.push((2 * nm + maps.len()) as u32);
+            for &u in ix {
+                let f = &self.coupling.fields[u];
+                maps.extend((0..f.components as u32).map(|c| first[u] + c));
+            }
+        }
+        table.extend(maps);
+        let table = setup.upload("material coupling", GpuData::U32(table));
+        kernel = kernel.bind("mat_coupling", table, Access::Read);
+        for (i, k) in self.coupling.keys.iter().enumerate() {
+            kernel = kernel.bind(&format!("cpl{i}"), setup.field(k)?, Access::Read);
+        }
+        Ok(kernel)
+    }
+
+    /// Fills `values` (stride [`Coupling::stride`] per element) with every element's
+    /// coupling values in its model's order: the mean of the element's node values
+    /// (summed in connectivity order, then divided by the node count) for a node field,
+    /// the element's value for an element field. The GPU's `coupling_of` repeats these
+    /// operations.
+    fn gather_coupling<D: Dim>(
+        &self,
+        conn: &[u32],
+        fields: &FieldStore,
+        values: &mut [f64],
+        backend: &Backend,
+    ) {
+        let (npe, stride) = (D::NODES_PER_ELEM, self.coupling.stride);
+        let data: Vec<&[f64]> = self
+            .coupling
+            .fields
+            .iter()
+            .map(|f| fields.get(f.id))
+            .collect();
+        backend.install(|| {
+            values
+                .par_chunks_mut(CHUNK * stride)
+                .enumerate()
+                .for_each(|(chunk, out)| {
+                    for (i, out) in out.chunks_exact_mut(stride).enumerate() {
+                        let e = chunk * CHUNK + i;
+                        let mut k = 0;
+                        for &u in &self.coupling.of_model[self.material[e] as usize] {
+                            let (f, v) = (&self.coupling.fields[u], data[u]);
+                            let nc = f.components;
+                            for c in 0..nc {
+                                out[k] = if f.node {
+                                    let mut sum = 0.0;
+                                    for &n in &conn[e * npe..(e + 1) * npe] {
+                                        sum += v[n as usize * nc + c];
+                                    }
+                                    sum / npe as f64
+                                } else {
+                                    v[e * nc + c]
+                                };
+                                k += 1;
+                            }
+                        }
+                    }
+                });
+        });
     }
 
     /// The model of element `e` (after init).
@@ -298,6 +524,7 @@ impl Mechanics {
         strain: &mut [f64],
         szz: &mut f64,
         state: &mut [f64],
+        coupling: &[f64],
     ) {
         let c = &inp.conn[3 * e..3 * e + 3];
         let (n0, n1, n2) = (c[0] as usize * 2, c[1] as usize * 2, c[2] as usize * 2);
@@ -336,7 +563,12 @@ impl Mechanics {
         strain.copy_from_slice(&[eps[0], eps[1], eps[3]]);
         let mut sig: Sym6 = [stress[0], stress[1], *szz, stress[2], 0.0, 0.0];
         let model = self.model_of(e);
-        model.update(&eps, &de, &mut sig, state);
+        let input = ModelInput {
+            strain: &eps,
+            dstrain: &de,
+            coupling,
+        };
+        model.update_with(&input, &mut sig, state);
         stress.copy_from_slice(&[sig[0], sig[1], sig[3]]);
         *szz = sig[2];
         let (mut sxx, mut syy, mut sxy) = (sig[0], sig[1], sig[3]);
@@ -402,6 +634,7 @@ impl Mechanics {
         strain: &mut [f64],
         rot: &mut [f64],
         state: &mut [f64],
+        coupling: &[f64],
     ) {
         let c = &inp.conn[4 * e..4 * e + 4];
         let n: [usize; 4] = [
@@ -445,7 +678,12 @@ impl Mechanics {
             stress[0], stress[1], stress[2], stress[3], stress[4], stress[5],
         ];
         let model = self.model_of(e);
-        model.update(&eps, &de, &mut sig, state);
+        let input = ModelInput {
+            strain: &eps,
+            dstrain: &de,
+            coupling,
+        };
+        model.update_with(&input, &mut sig, state);
         stress.copy_from_slice(&sig);
         if inp.damping && model.damp_factor() > 0.0 {
             let mut dv = [0.0; 9];
@@ -513,13 +751,27 @@ impl<D: Dim> Physics<D> for Mechanics {
         } else {
             names::ROTATION.own_sized::<D>(9)
         };
-        vec![
+        let mut uses = vec![
             names::STRESS.own::<D>(),
             names::STRAIN.own::<D>(),
             extra,
             names::MODEL_STATE.own_sized::<D>(n_state.max(1)),
             crate::actions::DISPLACEMENT_RESET.own::<D>(),
-        ]
+        ];
+        // Coupling inputs are read lagged: their owners (thermal, fluid) naturally come
+        // after the mechanics in a composition, and a fluid physics that reads joint
+        // openings must (the joints follow the mechanics), so a current-step read would
+        // refuse natural compositions. Lagged, the value is the one the field holds when
+        // the forces stage runs: this step's when the owner wrote it earlier in the step
+        // (composed before the mechanics, or in a field stage of the previous step),
+        // else the previous step's: at most one explicit step old, either way the same
+        // on both backends.
+        uses.extend(
+            coupling_keys(self.assignments.iter().map(|a| &a.1))
+                .into_iter()
+                .map(|k| k.read_lagged::<D>()),
+        );
+        uses
     }
 
     fn unique(&self) -> bool {
@@ -534,6 +786,7 @@ impl<D: Dim> Physics<D> for Mechanics {
         self.material = material;
         self.n_state = self.models.iter().map(|m| m.n_state()).max().unwrap_or(0);
         self.geo = geometry(mesh);
+        self.coupling = self.resolve_coupling(ctx.fields, ne)?;
         let stress = ctx.fields.id(names::STRESS)?;
         let strain = ctx.fields.id(names::STRAIN)?;
         let extra = ctx.fields.id(if D::D == 2 {
@@ -632,6 +885,13 @@ impl<D: Dim> Physics<D> for Mechanics {
             v: ctx.kin.v,
             damping: ctx.kin.damping,
         };
+        // Coupling values first (reading other physics' fields), then the element loop.
+        let cstride = self.coupling.stride;
+        let mut cvalues = std::mem::take(&mut self.coupling.values);
+        if cstride > 0 {
+            self.gather_coupling::<D>(inp.conn, ctx.fields, &mut cvalues, ctx.backend);
+        }
+        let cref = &cvalues;
         let [stress, strain, extra, state] = ctx
             .fields
             .get_many_mut([ids.stress, ids.strain, ids.extra, ids.state]);
@@ -653,14 +913,22 @@ impl<D: Dim> Physics<D> for Mechanics {
                         let st = &mut st[i * nsym..(i + 1) * nsym];
                         let ep = &mut ep[i * nsym..(i + 1) * nsym];
                         let ms = &mut ms[i * ns..(i + 1) * ns];
-                        if d == 2 {
-                            self.element_2d(e, &inp, sl, st, ep, &mut ex[i], ms);
+                        let cv: &[f64] = if cstride == 0 {
+                            &[]
                         } else {
-                            self.element_3d(e, &inp, sl, st, ep, &mut ex[i * 9..i * 9 + 9], ms);
+                            let n = self.coupling.len_of_model[self.material[e] as usize];
+                            &cref[e * cstride..e * cstride + n]
+                        };
+                        if d == 2 {
+                            self.element_2d(e, &inp, sl, st, ep, &mut ex[i], ms, cv);
+                        } else {
+                            let ex = &mut ex[i * 9..i * 9 + 9];
+                            self.element_3d(e, &inp, sl, st, ep, ex, ms, cv);
                         }
                     }
                 });
         });
+        self.coupling.values = cvalues;
         Ok(())
     }
 
@@ -677,10 +945,23 @@ impl<D: Dim> Physics<D> for Mechanics {
                 ),
             })?);
         }
+        // With coupling, every model function takes `coupling: Coupling` before `p`.
+        let coupled = self.coupling.stride > 0;
+        let (params, args) = if coupled {
+            (
+                "strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, coupling: Coupling, p: u32",
+                "strain, dstrain, stress, state, coupling, p",
+            )
+        } else {
+            (
+                "strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, p: u32",
+                "strain, dstrain, stress, state, p",
+            )
+        };
         let splice = splice_models(
             "model",
-            "strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, p: u32",
-            "strain, dstrain, stress, state, p",
+            params,
+            args,
             "Sym",
             Some("stress"),
             bodies.iter().map(|w| (w.key.as_str(), w.body.as_str())),
@@ -716,8 +997,18 @@ impl<D: Dim> Physics<D> for Mechanics {
         } else {
             include_str!("shaders/element_3d.wgsl")
         };
+        // The templates mark the model call's coupling argument with `/*coupling*/`:
+        // `coupling_of(e, mat), ` with coupling, nothing (the source unchanged) without.
+        let (coupling_src, template) = if coupled {
+            (
+                self.coupling_wgsl::<D>(),
+                template.replace("/*coupling*/", "coupling_of(e, mat), "),
+            )
+        } else {
+            (String::new(), template.replace("/*coupling*/", ""))
+        };
         let source = format!(
-            "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{}{template}",
+            "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{coupling_src}{}{template}",
             splice.source
         );
         let polar_tol = match setup.precision() {
@@ -751,6 +1042,11 @@ impl<D: Dim> Physics<D> for Mechanics {
                 Access::ReadWrite,
             )
             .bind("slots", setup.slots(), Access::ReadWrite);
+        let kernel = if coupled {
+            self.bind_coupling(setup, kernel)?
+        } else {
+            kernel
+        };
         setup.kernel(Phase::Forces, kernel)
     }
 

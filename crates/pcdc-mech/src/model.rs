@@ -4,7 +4,13 @@
 //! Tensors are passed as 6-component arrays in the order xx, yy, zz, xy, yz, xz with
 //! tensor (not engineering) shear strains. In 2D (plane strain) the kinematics pass
 //! ε_zz = ε_yz = ε_xz = 0 and keep σ_zz.
+//!
+//! A model that needs another physics' field (temperature, pore pressure) declares it in
+//! [`ConstitutiveModel::coupling`] and reads its value at the element from
+//! [`ModelInput::coupling`] in [`ConstitutiveModel::update_with`] (and `coupling[i]` in
+//! its WGSL body): see the crate documentation for an example.
 
+use pcdc_compute::FieldKey;
 use serde::{Deserialize, Serialize};
 
 use crate::MechError;
@@ -36,8 +42,32 @@ pub trait ConstitutiveModel: Send + Sync + std::fmt::Debug {
     }
     /// Updates `stress` (in: σ(t), out: σ(t+Δt), Pa) from the total strain `strain` and
     /// its increment `dstrain` over the step; `state` holds [`Self::n_state`] history
-    /// variables.
+    /// variables. The mechanics calls [`Self::update_with`], whose default calls this
+    /// method; a model that declares [`Self::coupling`] fields overrides
+    /// [`Self::update_with`] and implements this method as its law without coupling
+    /// inputs.
     fn update(&self, strain: &Sym6, dstrain: &Sym6, stress: &mut Sym6, state: &mut [f64]);
+    /// The coupling fields this model reads in [`Self::update_with`], in the order in
+    /// which it receives their values ([`ModelInput::coupling`]), e.g.
+    /// `&[names::TEMPERATURE]` for a thermo-elastic model
+    /// (`pcdc_compute::names::TEMPERATURE`, K; `PORE_PRESSURE`, Pa). Node and element
+    /// fields only; another physics must own each of them (the simulation builder
+    /// refuses a field without an owner, [`pcdc_compute::ComputeError::FieldWithoutOwner`]).
+    /// The mechanics reads them lagged (the value the field holds when the mechanics'
+    /// forces stage runs: this step's when the owner wrote it earlier in the step, else
+    /// the previous step's). Default: none, and then nothing is declared, allocated or
+    /// gathered.
+    fn coupling(&self) -> &[FieldKey] {
+        &[]
+    }
+    /// The update the mechanics calls for every element and step (manual eq. 12):
+    /// `stress` in: σ(t), out: σ(t+Δt) (Pa), from the inputs of `input` (strain, strain
+    /// increment and the values of the [`Self::coupling`] fields at the element); `state`
+    /// holds [`Self::n_state`] history variables. The default ignores the coupling values
+    /// and calls [`Self::update`]; a model that reads coupling fields overrides it.
+    fn update_with(&self, input: &ModelInput<'_>, stress: &mut Sym6, state: &mut [f64]) {
+        self.update(input.strain, input.dstrain, stress, state)
+    }
     /// The constant tangent `dσ/dε` as a 6x6 matrix acting on tensor strain components
     /// (`σ_xy = T[3][3] ε_xy`, ...), if the model is linear; enables the direct static solve.
     fn linear_tangent(&self) -> Option<[[f64; 6]; 6]> {
@@ -61,16 +91,56 @@ pub trait ConstitutiveModel: Send + Sync + std::fmt::Debug {
     }
 }
 
+/// What a constitutive model receives for one element in one step, besides its stress
+/// and history ([`ConstitutiveModel::update_with`]). Built by the mechanics; new inputs
+/// may be added (the struct is `#[non_exhaustive]`), so models keep compiling.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct ModelInput<'a> {
+    /// Total strain ε(t+Δt) in the element's co-rotated frame (tensor components, xx,
+    /// yy, zz, xy, yz, xz; in 2D plane strain ε_zz = ε_yz = ε_xz = 0).
+    pub strain: &'a Sym6,
+    /// Strain increment Δε over the step (same layout).
+    pub dstrain: &'a Sym6,
+    /// The values of the model's [`ConstitutiveModel::coupling`] fields at the element,
+    /// in declaration order, each field's components in a row: for a node field the mean
+    /// of the element's node values (Σ_a v_a / N, nodes in connectivity order), for an
+    /// element field the element's value. Units those of the field (temperature K,
+    /// pore pressure Pa). Empty for a model that declares none.
+    pub coupling: &'a [f64],
+}
+
+impl<'a> ModelInput<'a> {
+    /// The inputs of one update (e.g. to call [`ConstitutiveModel::update_with`] in a
+    /// test).
+    pub fn new(strain: &'a Sym6, dstrain: &'a Sym6, coupling: &'a [f64]) -> Self {
+        ModelInput {
+            strain,
+            dstrain,
+            coupling,
+        }
+    }
+}
+
 /// A constitutive model's GPU code, spliced into the element kernel template.
 ///
 /// `body` is the body of
 /// `fn (strain: Sym, dstrain: Sym, stress: Sym, state: ptr<function, ModelState>, p: u32) -> Sym`
 /// where `Sym = array<Real, 6>` holds xx, yy, zz, xy, yz, xz (tensor shear strains, as
 /// on the CPU), `stress` is σ(t), the function returns σ(t+Δt), `(*state)[k]` are the
-/// history variables and `param(p, k)` reads `params[k]`. `Real` is `f64` or `f32` by
-/// precision: write literals without suffix (`0.5`, not `0.5f`) and keep to + − × ÷,
-/// `sqrt`, `abs`, `min`, `max`, `select` (drivers may lack f64 `exp`/`pow`/`sin`). To match
-/// the CPU to rounding, repeat the CPU's operations in the same order.
+/// history variables and `param(p, k)` reads `params[k]`.
+///
+/// When a model of the mechanics declares coupling fields
+/// ([`ConstitutiveModel::coupling`]), every model function takes one more parameter,
+/// `coupling: Coupling` (`array<Real, N>`, N the largest value count of
+/// the models), after `state`: the model's values of [`ModelInput::coupling`], computed
+/// as on the CPU (entries beyond the model's own count are zero). Without coupling the
+/// parameter does not exist, so only a model that declares coupling fields may read it.
+///
+/// `Real` is `f64` or `f32` by precision: write literals without suffix (`0.5`, not
+/// `0.5f`) and keep to + − × ÷, `sqrt`, `abs`, `min`, `max`, `select` (drivers may lack
+/// f64 `exp`/`pow`/`sin`). To match the CPU to rounding, repeat the CPU's operations in
+/// the same order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WgslModel {
     /// Identifies the code: models with equal keys must have equal bodies (they share one

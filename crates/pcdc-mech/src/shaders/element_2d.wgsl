@@ -49,7 +49,7 @@ fn kernel(e: u32) {
     }
     let sig0 = Sym(stress[3u * e], stress[3u * e + 1u], stress_zz[e], stress[3u * e + 2u], 0.0, 0.0);
     let mat = material[e];
-    let sig = call_model(mat_info[2u * mat], eps, de, sig0, &st, mat_info[2u * mat + 1u]);
+    let sig = call_model(mat_info[2u * mat], eps, de, sig0, &st, /*coupling*/mat_info[2u * mat + 1u]);
     for (var k = 0u; k < NSTATE; k = k + 1u) {
         model_state[e * NSTATE + k] = st[k];
     }

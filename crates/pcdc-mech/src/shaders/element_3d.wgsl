@@ -108,7 +108,7 @@ fn kernel(e: u32) {
         st[k] = model_state[e * NSTATE + k];
     }
     let mat = material[e];
-    var sig = call_model(mat_info[2u * mat], eps, de, sig0, &st, mat_info[2u * mat + 1u]);
+    var sig = call_model(mat_info[2u * mat], eps, de, sig0, &st, /*coupling*/mat_info[2u * mat + 1u]);
     for (var k = 0u; k < NSTATE; k = k + 1u) {
         model_state[e * NSTATE + k] = st[k];
     }
