@@ -13,7 +13,10 @@
 //! fully broken joint, on the split mesh's faces: the field contact picks up), and per
 //! joint the kinematics other physics read: `joint_opening` (δ̄·n at the face centroid),
 //! `joint_sliding` (δ̄ − (δ̄·n) n, D components) and `joint_normal` (n), written by the
-//! same kernel, for broken joints too.
+//! same kernel, for broken joints too. It reads (lagged) the coupling fields its models
+//! ask for ([`JointModel::coupling`]) and passes each model their values at the joint
+//! ([`crate::JointInput::coupling`]); when no model asks, it declares and gathers
+//! nothing.
 //!
 //! A broken joint (largest damage 1) transfers no force from the next step on, whatever
 //! its model: its faces interact through contact alone. Integrating it further would
@@ -28,19 +31,19 @@
 use std::sync::Arc;
 
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
+use pcdc_compute::{Backend, FieldKey, FieldUse, Location};
 use pcdc_compute::{
     ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
     StableStep,
 };
 use pcdc_compute::{Entity, EntityKind};
-use pcdc_compute::{FieldKey, FieldUse};
 use pcdc_mesh::{Dim, Interfaces, Mesh, Range};
 use rayon::prelude::*;
 
 use crate::fields::{
     BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
 };
-use crate::JointModel;
+use crate::{JointInput, JointModel};
 
 const JOINT_KERNEL: &str = include_str!("shaders/joints.wgsl");
 const JOINT_LIBRARY: &str = include_str!("shaders/joint_library.wgsl");
@@ -123,6 +126,49 @@ pub struct CohesiveJoints {
     rule: Vec<([f64; 3], f64)>,
     n_state: usize,
     ids: Option<[FieldId; 6]>,
+    coupling: Coupling,
+}
+
+/// One coupling field read by the joint models, as found in the field store at init.
+#[derive(Clone, Copy, Debug)]
+struct CouplingField {
+    id: FieldId,
+    /// A node field (mean of the joint's face nodes); else an element field (mean of
+    /// its two elements).
+    node: bool,
+    /// Values per entity.
+    components: usize,
+}
+
+/// The coupling inputs of the joint models (all empty when no model declares any).
+#[derive(Clone, Debug, Default)]
+struct Coupling {
+    /// The keys the models declare, each once, in order of first declaration.
+    keys: Vec<FieldKey>,
+    /// The fields of `keys`, after init.
+    fields: Vec<CouplingField>,
+    /// Per model: indices into `fields` of its keys, in its declaration order.
+    of_model: Vec<Vec<usize>>,
+    /// Per model: its number of coupling values (the components of its keys).
+    len_of_model: Vec<usize>,
+    /// Values per joint in `values`: the largest of `len_of_model` (0: no coupling).
+    stride: usize,
+    /// Each joint's values in its model's order, `stride` per joint, refreshed at the
+    /// start of every force evaluation (scratch, not state).
+    values: Vec<f64>,
+}
+
+/// The coupling keys the models declare, each once, in order of first declaration.
+fn coupling_keys<'a>(models: impl Iterator<Item = &'a Arc<dyn JointModel>>) -> Vec<FieldKey> {
+    let mut keys: Vec<FieldKey> = Vec::new();
+    for m in models {
+        for k in m.coupling() {
+            if !keys.contains(k) {
+                keys.push(*k);
+            }
+        }
+    }
+    keys
 }
 
 impl Default for CohesiveJoints {
@@ -147,6 +193,7 @@ impl CohesiveJoints {
             rule: Vec::new(),
             n_state: 1,
             ids: None,
+            coupling: Coupling::default(),
         }
     }
 
@@ -186,15 +233,193 @@ impl CohesiveJoints {
         self.rule.len() * self.n_state
     }
 
+    /// The coupling inputs of the resolved models: the fields they read (node or element
+    /// fields, declared by their owners), each model's indices and value count, and the
+    /// value buffer (allocated only when a model reads a field).
+    fn resolve_coupling(&self, fields: &FieldStore) -> Result<Coupling, ComputeError> {
+        let keys = coupling_keys(self.models.iter());
+        if keys.is_empty() {
+            return Ok(Coupling::default());
+        }
+        let mut resolved = Vec::with_capacity(keys.len());
+        for k in &keys {
+            let id = fields.id(k)?;
+            let spec = fields.spec(id);
+            let node = match spec.location {
+                Location::Node => true,
+                Location::Element => false,
+                other => {
+                    let model = self
+                        .models
+                        .iter()
+                        .find(|m| m.coupling().contains(k))
+                        .map_or("?", |m| m.name());
+                    return Err(ComputeError::param(
+                        format!("coupling field '{k}' of joint model '{model}'"),
+                        format!("{other:?}"),
+                        "a joint model reads node or element fields only",
+                    ));
+                }
+            };
+            resolved.push(CouplingField {
+                id,
+                node,
+                components: spec.components,
+            });
+        }
+        let of_model: Vec<Vec<usize>> = self
+            .models
+            .iter()
+            .map(|m| {
+                m.coupling()
+                    .iter()
+                    .filter_map(|k| keys.iter().position(|u| u == k))
+                    .collect()
+            })
+            .collect();
+        let len_of_model: Vec<usize> = of_model
+            .iter()
+            .map(|ix| ix.iter().map(|&i| resolved[i].components).sum())
+            .collect();
+        let stride = len_of_model.iter().copied().max().unwrap_or(0);
+        Ok(Coupling {
+            keys,
+            fields: resolved,
+            of_model,
+            len_of_model,
+            stride,
+            values: vec![0.0; self.joints.len() * stride],
+        })
+    }
+
+    /// Fills `values` (stride [`Coupling::stride`] per joint) with every joint's
+    /// coupling values in its model's order: the mean of the joint's face nodes (side A,
+    /// then side B, summed in that order, then divided by 2 NPF) for a node field, the
+    /// mean of its two elements ((0 + v_A) + v_B) / 2 for an element field. The GPU's
+    /// `joint_coupling_of` repeats these operations.
+    fn gather_coupling<D: Dim>(&self, fields: &FieldStore, values: &mut [f64], backend: &Backend) {
+        let (npf, stride) = (D::NODES_PER_FACE, self.coupling.stride);
+        let data: Vec<&[f64]> = self
+            .coupling
+            .fields
+            .iter()
+            .map(|f| fields.get(f.id))
+            .collect();
+        backend.install(|| {
+            values
+                .par_chunks_mut(CHUNK * stride)
+                .enumerate()
+                .for_each(|(chunk, out)| {
+                    for (i, out) in out.chunks_exact_mut(stride).enumerate() {
+                        let j = chunk * CHUNK + i;
+                        let nodes = self.joints.joint_nodes(j);
+                        let elements = &self.joints.elements()[2 * j..2 * j + 2];
+                        let mut k = 0;
+                        for &u in &self.coupling.of_model[self.model_of[j] as usize] {
+                            let (f, v) = (&self.coupling.fields[u], data[u]);
+                            let nc = f.components;
+                            let (at, count) = if f.node {
+                                (nodes, 2 * npf)
+                            } else {
+                                (elements, 2)
+                            };
+                            for c in 0..nc {
+                                let mut sum = 0.0;
+                                for &n in at {
+                                    sum += v[n as usize * nc + c];
+                                }
+                                out[k] = sum / count as f64;
+                                k += 1;
+                            }
+                        }
+                    }
+                });
+        });
+    }
+
+    /// The WGSL of the coupling inputs (only with coupling): the `JointCoupling` alias
+    /// and `joint_coupling_of(j, r)` (joint `j`, `r` its row in `joint_info`), which
+    /// computes every coupling field's values at the joint (the operations of
+    /// [`Self::gather_coupling`]) and returns those of the joint's model in its order
+    /// (zero beyond its count), through the table `joint_coupling`
+    /// ([`Self::bind_coupling`]). With coupling, a `joint_info` row ends with the
+    /// joint's model index and its two elements (A, B).
+    fn coupling_wgsl<D: Dim>(&self) -> String {
+        let npf = D::NODES_PER_FACE;
+        let total: usize = self.coupling.fields.iter().map(|f| f.components).sum();
+        let mut src = format!(
+            "alias JointCoupling = array<Real, {}u>;\nfn joint_coupling_of(j: u32, r: u32) -> JointCoupling {{\n    var all: array<Real, {total}u>;\n",
+            self.coupling.stride
+        );
+        let mut at = 0;
+        for (i, f) in self.coupling.fields.iter().enumerate() {
+            let nc = f.components;
+            // Row offsets of the nodes (both sides) or of the two elements.
+            let (first, count) = if f.node {
+                (0, 2 * npf)
+            } else {
+                (2 * npf + 5, 2)
+            };
+            src.push_str(&format!(
+                "    // '{}'\n    for (var c = 0u; c < {nc}u; c = c + 1u) {{\n        var sum = Real(0.0);\n        for (var a = 0u; a < {count}u; a = a + 1u) {{\n            sum = sum + cpl{i}[joint_info[r + {first}u + a] * {nc}u + c];\n        }}\n        all[{at}u + c] = sum / Real({count}.0);\n    }}\n",
+                self.coupling.keys[i]
+            ));
+            at += nc;
+        }
+        src.push_str(&format!(
+            "    var out: JointCoupling;\n    let m = joint_info[r + {}u];\n    let n = joint_coupling[2u * m];\n    let o = joint_coupling[2u * m + 1u];\n    for (var k = 0u; k < n; k = k + 1u) {{\n        out[k] = all[joint_coupling[o + k]];\n    }}\n    return out;\n}}\n",
+            2 * npf + 4
+        ));
+        src
+    }
+
+    /// Binds the coupling fields (`cpl0`, `cpl1`, ... in the order of
+    /// [`Coupling::keys`], read only) and the table `joint_coupling`: per model its
+    /// value count and the offset of its map, then the maps (per value, its index in
+    /// `joint_coupling_of`'s `all`).
+    fn bind_coupling<D: Dim>(
+        &self,
+        setup: &mut GpuSetup<'_, D>,
+        mut kernel: Kernel,
+    ) -> Result<Kernel, ComputeError> {
+        let mut first = Vec::with_capacity(self.coupling.fields.len());
+        let mut at = 0u32;
+        for f in &self.coupling.fields {
+            first.push(at);
+            at += f.components as u32;
+        }
+        let nm = self.models.len();
+        let mut table: Vec<u32> = Vec::with_capacity(2 * nm);
+        let mut maps: Vec<u32> = Vec::new();
+        for (m, ix) in self.coupling.of_model.iter().enumerate() {
+            table.push(self.coupling.len_of_model[m] as u32);
+            table.push((2 * nm + maps.len()) as u32);
+            for &u in ix {
+                let f = &self.coupling.fields[u];
+                maps.extend((0..f.components as u32).map(|c| first[u] + c));
+            }
+        }
+        table.extend(maps);
+        let table = setup.upload("joint coupling", GpuData::U32(table));
+        kernel = kernel.bind("joint_coupling", table, Access::Read);
+        for (i, k) in self.coupling.keys.iter().enumerate() {
+            kernel = kernel.bind(&format!("cpl{i}"), setup.field(k)?, Access::Read);
+        }
+        Ok(kernel)
+    }
+
     /// Joint `j`'s opening, sliding and normal into `out` and, unless it is `broken`
     /// (then its slots are zeroed and its damage returned unchanged as `None`), its
-    /// forces into `slots` (2·NPF·D values), its state update and its damage.
+    /// forces into `slots` (2·NPF·D values), its state update and its damage; its
+    /// model receives the joint's `coupling` values.
+    #[allow(clippy::too_many_arguments)]
     fn joint<D: Dim>(
         &self,
         j: usize,
         kin: &Kinematics<'_, D>,
         slots: &mut [f64],
         state: &mut [f64],
+        coupling: &[f64],
         out: JointOut<'_>,
         broken: bool,
     ) -> Option<f64> {
@@ -253,7 +478,13 @@ impl CohesiveJoints {
                 s[c] = delta[c] - o * n[c];
             }
             let st = &mut state[g * ns..(g + 1) * ns];
-            let t = model.traction(o, &s[..d], self.h[j], st);
+            let input = JointInput {
+                opening: o,
+                slip: &s[..d],
+                h: self.h[j],
+                coupling,
+            };
+            let t = model.traction_with(&input, st);
             damage = damage.max(model.damage(st));
             let mut tv = [0.0; 3];
             for c in 0..d {
@@ -294,14 +525,26 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let points = if D::D == 2 { 3 } else { self.gauss_3d };
         let ns = self.assigned_state_len();
         let nj = mesh.interfaces().len();
-        vec![
+        let mut uses = vec![
             own_per_joint::<D>(JOINT_STATE, nj, Some(points * ns)),
             own_per_joint::<D>(JOINT_DAMAGE, nj, None),
             BROKEN_FACE.own::<D>(),
             own_per_joint::<D>(JOINT_OPENING, nj, None),
             own_per_joint::<D>(JOINT_SLIDING, nj, None),
             own_per_joint::<D>(JOINT_NORMAL, nj, None),
-        ]
+        ];
+        // Coupling inputs are read lagged: a fluid physics reads the joints' openings
+        // (JOINT_OPENING, written here in the forces stage) and so runs after the joints,
+        // and a thermal physics is naturally composed after them too; a current-step
+        // read would refuse those compositions. The value is the one the field holds
+        // when the joints' forces stage runs: at most one explicit step old, the same on
+        // both backends.
+        uses.extend(
+            coupling_keys(self.assignments.iter().map(|a| &a.1))
+                .into_iter()
+                .map(|k| k.read_lagged::<D>()),
+        );
+        uses
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
@@ -401,6 +644,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
             }
         }
         self.ids = Some(ids);
+        self.coupling = self.resolve_coupling(ctx.fields)?;
         ctx.register_slots(self.joints.nodes())?;
         Ok(())
     }
@@ -445,6 +689,13 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let [sid, did, bid, oid, lid, nid] = self.ids.expect("init ran");
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let stride = self.state_stride();
+        // Coupling values first (reading other physics' fields), then the joint loop.
+        let cstride = self.coupling.stride;
+        let mut cvalues = std::mem::take(&mut self.coupling.values);
+        if cstride > 0 {
+            self.gather_coupling::<D>(ctx.fields, &mut cvalues, ctx.backend);
+        }
+        let cref = &cvalues;
         let kin = &ctx.kin;
         let [state, damage, opening, sliding, normal] =
             ctx.fields.get_many_mut([sid, did, oid, lid, nid]);
@@ -466,6 +717,12 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                             sliding: &mut sd[i * d..(i + 1) * d],
                             normal: &mut nm[i * d..(i + 1) * d],
                         };
+                        let cv: &[f64] = if cstride == 0 {
+                            &[]
+                        } else {
+                            let n = self.coupling.len_of_model[self.model_of[j] as usize];
+                            &cref[j * cstride..j * cstride + n]
+                        };
                         // A broken joint transfers no force; its kinematics are still
                         // published.
                         if let Some(dmg) = self.joint::<D>(
@@ -473,6 +730,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                             kin,
                             &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d],
                             &mut st[i * stride..(i + 1) * stride],
+                            cv,
                             out,
                             dm[i] >= 1.0,
                         ) {
@@ -481,6 +739,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                     }
                 })
         });
+        self.coupling.values = cvalues;
         let [damage, broken] = ctx.fields.get_many_mut([did, bid]);
         for (j, &dmg) in damage.iter().enumerate() {
             if dmg >= 1.0 {
@@ -519,14 +778,28 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                 ),
             })?);
         }
+        // With coupling, every model function takes `coupling: JointCoupling` before `p`.
+        let coupled = self.coupling.stride > 0;
+        let (params, args) = if coupled {
+            (
+                "o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, coupling: JointCoupling, p: u32",
+                "o, slip, h, state, coupling, p",
+            )
+        } else {
+            (
+                "o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32",
+                "o, slip, h, state, p",
+            )
+        };
         let splice = splice_models(
             "joint_model",
-            "o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32",
-            "o, slip, h, state, p",
+            params,
+            args,
             "JointTraction",
             None,
             bodies.iter().map(|w| (w.key.as_str(), w.body.as_str())),
         );
+
         let mut model_info = Vec::with_capacity(bodies.len());
         for (w, kind) in bodies.iter().zip(&splice.kinds) {
             model_info.push([*kind, data.len() as u32]);
@@ -534,20 +807,47 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         }
         let h_at = data.len();
         data.extend_from_slice(&self.h);
-        // Per joint: side A nodes, side B nodes, faces A and B, model kind, parameter offset.
-        let info_stride = 2 * npf + 4;
+        // Per joint: side A nodes, side B nodes, faces A and B, model kind, parameter
+        // offset; with coupling also the model index and the elements A and B.
+        let info_stride = 2 * npf + if coupled { 7 } else { 4 };
         let mut info = Vec::with_capacity(nj * info_stride);
         for j in 0..nj {
             info.extend_from_slice(self.joints.joint_nodes(j));
             info.extend_from_slice(&self.joints.faces()[2 * j..2 * j + 2]);
             info.extend_from_slice(&model_info[self.model_of[j] as usize]);
+            if coupled {
+                info.push(u32::from(self.model_of[j]));
+                info.extend_from_slice(&self.joints.elements()[2 * j..2 * j + 2]);
+            }
         }
         let info = setup.upload("joint info", GpuData::U32(info));
         let data = setup.upload("joint data", GpuData::Real(data));
+        // The kernel marks the coupling values (computed once per joint) with
+        // `/*coupling_values*/` and the model call's argument with `/*coupling*/`;
+        // without coupling both marks vanish and the source is unchanged.
+        let (coupling_src, template) = if coupled {
+            (
+                self.coupling_wgsl::<D>(),
+                JOINT_KERNEL
+                    .replace(
+                        "/*coupling_values*/",
+                        "\n    let jc = joint_coupling_of(j, r);",
+                    )
+                    .replace("/*coupling*/", "jc, "),
+            )
+        } else {
+            (
+                String::new(),
+                JOINT_KERNEL
+                    .replace("/*coupling_values*/", "")
+                    .replace("/*coupling*/", ""),
+            )
+        };
         let source = format!(
-            "alias JointVec = array<Real, 3>;\nalias JointState = array<Real, NSTATE>;\nstruct JointTraction {{\n    normal: Real,\n    shear: JointVec,\n    damage: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return joint_data[p + k]; }}\n{JOINT_LIBRARY}{WGSL_GEOMETRY}{}{JOINT_KERNEL}",
+            "alias JointVec = array<Real, 3>;\nalias JointState = array<Real, NSTATE>;\nstruct JointTraction {{\n    normal: Real,\n    shear: JointVec,\n    damage: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return joint_data[p + k]; }}\n{JOINT_LIBRARY}{WGSL_GEOMETRY}{}{coupling_src}{template}",
             splice.source
         );
+
         let mut kernel = Kernel::new(format!("cohesive joints {}", D::NAME), source, nj)
             .const_u32("D", D::D as u32)
             .const_u32("NPF", npf as u32)
@@ -588,6 +888,11 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                 Access::ReadWrite,
             )
             .bind("slots", setup.slots(), Access::ReadWrite);
+        let kernel = if coupled {
+            self.bind_coupling(setup, kernel)?
+        } else {
+            kernel
+        };
         setup.kernel(Phase::Forces, kernel)
     }
 }

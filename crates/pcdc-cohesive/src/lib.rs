@@ -21,6 +21,17 @@
 //! model's WGSL body ([`JointModel::wgsl`], [`WgslJointModel`]) is spliced; the built-in
 //! models provide one, and the softening curve uses the hand-written [`portable_exp`] on
 //! both backends so that f64 results agree to rounding.
+//!
+//! A joint model that needs another physics' field (fluid pressure in the joint,
+//! temperature) names it in [`JointModel::coupling`] (e.g.
+//! `pcdc_compute::names::PORE_PRESSURE`) and overrides [`JointModel::traction_with`]:
+//! [`JointInput::coupling`] holds the values at the joint (node field: mean of the
+//! joint's face nodes on both sides; element field: mean of its two elements), the same
+//! at every Gauss point, and its WGSL body reads them as `coupling[i]`. The physics that
+//! owns the field must be composed (else
+//! [`pcdc_compute::ComputeError::FieldWithoutOwner`]); [`CohesiveJoints`] reads it
+//! lagged, so a fluid physics that reads the joints' openings may run after them.
+//! Models that ask for nothing cost nothing: no field, no gather, the kernel unchanged.
 
 #![warn(missing_docs)]
 // Index loops mirror the tensor notation of the manual's equations.
@@ -40,6 +51,6 @@ pub use fractures::{joints_on_fractures, Distribution, Fracture, FractureNetwork
 pub use joints::CohesiveJoints;
 pub use model::{
     czm_state, portable_exp, softening, softening_integral, FailureMode, IntrinsicCzm,
-    IntrinsicCzmParams, JointModel, MohrCoulombJoint, MohrCoulombJointParams, Traction,
+    IntrinsicCzmParams, JointInput, JointModel, MohrCoulombJoint, MohrCoulombJointParams, Traction,
     WgslJointModel, SOFTENING_A, SOFTENING_B, SOFTENING_C,
 };

@@ -6,6 +6,7 @@
 //! pulls the faces together (cohesion) and negative when it pushes them apart
 //! (overlap); the shear traction opposes the slip.
 
+use pcdc_compute::FieldKey;
 use serde::{Deserialize, Serialize};
 
 use crate::CohesiveError;
@@ -187,8 +188,32 @@ pub trait JointModel: Send + Sync + std::fmt::Debug {
     /// characteristic length `h` (m); updates the history in `state`. Once the joint's
     /// largest [`JointModel::damage`] reaches 1 the physics stops calling the model and
     /// the joint transfers no force (contact takes over); a model whose own broken state
-    /// still returned a traction would be ignored from then on.
+    /// still returned a traction would be ignored from then on. The physics calls
+    /// [`JointModel::traction_with`], whose default calls this method; a model that
+    /// declares [`JointModel::coupling`] fields overrides [`JointModel::traction_with`]
+    /// and implements this method as its law without coupling inputs.
     fn traction(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction;
+    /// The coupling fields this model reads in [`JointModel::traction_with`], in the
+    /// order in which it receives their values ([`JointInput::coupling`]), e.g.
+    /// `&[names::PORE_PRESSURE]` for a joint under fluid pressure
+    /// (`pcdc_compute::names`: `TEMPERATURE`, K; `PORE_PRESSURE`, Pa). Node and element
+    /// fields only; another physics must own each of them (the simulation builder
+    /// refuses a field without an owner,
+    /// [`pcdc_compute::ComputeError::FieldWithoutOwner`]). The joints read them lagged
+    /// (the value the field holds when the joints' forces stage runs: at most one step
+    /// old), since a fluid physics reads the joints' openings and so runs after them.
+    /// Default: none, and then nothing is declared, allocated or gathered.
+    fn coupling(&self) -> &[FieldKey] {
+        &[]
+    }
+    /// The traction the joint physics asks for at every Gauss point and step: the
+    /// arguments of [`JointModel::traction`] and the values of the
+    /// [`JointModel::coupling`] fields at the joint, in `input`; updates the history in
+    /// `state`. The default ignores the coupling values and calls
+    /// [`JointModel::traction`]; a model that reads coupling fields overrides it.
+    fn traction_with(&self, input: &JointInput<'_>, state: &mut [f64]) -> Traction {
+        self.traction(input.opening, input.slip, input.h, state)
+    }
     /// Largest penalty stiffness per unit area (Pa/m) at characteristic length `h`,
     /// for the stable time step.
     fn max_stiffness(&self, h: f64) -> f64;
@@ -208,6 +233,42 @@ pub trait JointModel: Send + Sync + std::fmt::Debug {
     /// ([`pcdc_compute::ComputeError::NoGpuKernel`]).
     fn wgsl(&self) -> Option<WgslJointModel> {
         None
+    }
+}
+
+/// What a joint model receives at one Gauss point of one joint in one step, besides its
+/// history ([`JointModel::traction_with`]). Built by the joint physics; new inputs may
+/// be added (the struct is `#[non_exhaustive]`), so models keep compiling.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct JointInput<'a> {
+    /// Opening o (m): positive when the faces separate, negative when they overlap.
+    pub opening: f64,
+    /// Slip vector (m): the tangential gap of side B relative to side A, global
+    /// components, length `D`.
+    pub slip: &'a [f64],
+    /// Characteristic length h of the joint (m): the mean edge length of its two
+    /// elements.
+    pub h: f64,
+    /// The values of the model's [`JointModel::coupling`] fields at the joint (the same
+    /// at every Gauss point), in declaration order, each field's components in a row:
+    /// for a node field the mean of the joint's face nodes on both sides (Σ v / (2
+    /// NPF): side A's nodes, then side B's, in the joint's node order), for an element
+    /// field the mean of its two elements (A, then B). Units those of the field
+    /// (temperature K, pore pressure Pa). Empty for a model that declares none.
+    pub coupling: &'a [f64],
+}
+
+impl<'a> JointInput<'a> {
+    /// The inputs of one evaluation (e.g. to call [`JointModel::traction_with`] in a
+    /// test).
+    pub fn new(opening: f64, slip: &'a [f64], h: f64, coupling: &'a [f64]) -> Self {
+        JointInput {
+            opening,
+            slip,
+            h,
+            coupling,
+        }
     }
 }
 
@@ -236,6 +297,14 @@ pub trait JointModel: Send + Sync + std::fmt::Debug {
 /// and call the library functions `portable_exp(x)` ([`portable_exp`]) and
 /// `softening(d)` ([`softening`], eq. 69). A fresh `var t: JointTraction;` is all
 /// zeros.
+///
+/// When a joint model of the physics declares coupling fields
+/// ([`JointModel::coupling`]), every model function takes one more parameter,
+/// `coupling: JointCoupling` (`array<Real, N>`, N the largest value
+/// count of the models), after `state`: the model's values of [`JointInput::coupling`],
+/// computed as on the CPU (entries beyond the model's own count are zero). Without
+/// coupling the parameter does not exist, so only a model that declares coupling fields
+/// may read it.
 ///
 /// `Real` is `f64` or `f32` by precision: write literals without suffix, and wrap them
 /// in `Real(..)` where a `var` would otherwise default to f32 (`var x = Real(0.0);`).

@@ -59,7 +59,7 @@ fn kernel(j: u32) {
     }
     let kind = joint_info[r + 2u * NPF + 2u];
     let p = joint_info[r + 2u * NPF + 3u];
-    let h = joint_data[H_AT + j];
+    let h = joint_data[H_AT + j];/*coupling_values*/
     var f: array<Real, 18>;
     var damage = Real(0.0);
     for (var g = 0u; g < NGAUSS; g = g + 1u) {
@@ -83,7 +83,7 @@ fn kernel(j: u32) {
         for (var k = 0u; k < NSTATE; k = k + 1u) {
             st[k] = joint_state[b + k];
         }
-        let t = call_joint_model(kind, o, s, h, &st, p);
+        let t = call_joint_model(kind, o, s, h, &st, /*coupling*/p);
         for (var k = 0u; k < NSTATE; k = k + 1u) {
             joint_state[b + k] = st[k];
         }
