@@ -22,12 +22,16 @@
 //!    candidates: the sets of the CPU's [`crate::grid_candidates`] /
 //!    [`crate::grid_candidates_3d`];
 //! 6. `reference` (per node): positions of this build;
-//! 7. `forces` (per element): Munjiza's potential force (`potential2d.wgsl`,
+//! 7. `vertices` (per vertex of the bonded regions, only when bonds are declared): this
+//!    step's intact and closed flags from the broken-bond field (the CPU's
+//!    `BondedRegions::update`, see the `exclusion` module);
+//! 8. `forces` (per element): Munjiza's potential force (`potential2d.wgsl`,
 //!    `potential3d.wgsl`: [`crate::triangle_pair_force`], [`crate::tet_pair_force`]) and
 //!    the contact law for every candidate (`contact_forces.wgsl`, `contact_forces_3d.wgsl`:
 //!    the CPU's `apply_model` / `apply_model3`; in 3D a pair whose potential force is
 //!    exactly zero skips the law and restarts its history, as on the CPU), the
-//!    element's own share written to its slots.
+//!    element's own share written to its slots; sealed elements and pairs that share an
+//!    intact vertex are skipped (`regions.wgsl`).
 //!
 //! The broad-phase kernels are one source for both dimensions, specialised by the
 //! constants `D` (dimension) and `NPE` (nodes per element). Integer atomics count and
@@ -66,6 +70,7 @@ use crate::model::ContactModel;
 
 const COMMON: &str = include_str!("shaders/broad_common.wgsl");
 const CELLS: &str = include_str!("shaders/broad_cells.wgsl");
+const REGIONS: &str = include_str!("shaders/regions.wgsl");
 
 /// Bonded neighbours of one element: (neighbour, face), sorted by neighbour.
 pub(crate) type BondList = Vec<(u32, u32)>;
@@ -83,6 +88,8 @@ pub(crate) struct GpuContactInput<'a> {
     pub capacity: usize,
     /// History values per pair in the history field.
     pub stride: usize,
+    /// The vertex topology of the bonded regions (with the bonds).
+    pub regions: Option<&'a crate::exclusion::BondedRegions>,
 }
 
 /// Declares the contact kernels.
@@ -171,6 +178,25 @@ pub(crate) fn setup<D: Dim>(
         Some(b) => b,
         None => setup.upload("no bonds", GpuData::Real(vec![0.0])),
     };
+    // The bonded regions' vertex topology and this step's vertex flags.
+    let nv = input.regions.map_or(0, |r| r.n_vertices());
+    let (elem_vertex, vertex_ptr, vertex_faces, vertex_static) = match input.regions {
+        Some(r) => (
+            r.elem_vertex.clone(),
+            r.vertex_ptr.clone(),
+            r.vertex_faces.clone(),
+            r.vertex_static.clone(),
+        ),
+        None => (vec![0], vec![0, 0], vec![0], vec![0]),
+    };
+    let mut vertex_faces = vertex_faces;
+    vertex_faces.resize(vertex_faces.len().max(1), 0);
+    let elem_vertex = setup.upload("element vertices", GpuData::U32(elem_vertex));
+    let vertex_ptr = setup.upload("vertex bond pointers", GpuData::U32(vertex_ptr));
+    let vertex_faces = setup.upload("vertex bond faces", GpuData::U32(vertex_faces));
+    let vertex_static = setup.upload("vertex topology", GpuData::U32(vertex_static));
+    let vertex_flags = setup.upload("vertex flags", GpuData::U32(vec![0; nv.max(1)]));
+    let regions = nv > 0;
     let overflow = setup.error(move |e| crate::physics::overflow_message(e, capacity));
     let tiny = match setup.precision() {
         Precision::F64 => f64::MIN_POSITIVE,
@@ -191,7 +217,7 @@ pub(crate) fn setup<D: Dim>(
         )
     };
     let forces_source = format!(
-        "alias ContactState = array<Real, NSTATE>;\nstruct ContactStress {{\n    normal: Real,\n    shear: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return model_data[p + k]; }}\nfn pair_penalty(c: u32, t: u32, p: u32) -> Real {{\n{}\n}}\n{potential}{}{forces}",
+        "alias ContactState = array<Real, NSTATE>;\nstruct ContactStress {{\n    normal: Real,\n    shear: Real,\n}}\nfn param(p: u32, k: u32) -> Real {{ return model_data[p + k]; }}\nfn pair_penalty(c: u32, t: u32, p: u32) -> Real {{\n{}\n}}\n{potential}{}{REGIONS}{forces}",
         wgsl.pair_penalty.as_deref().unwrap_or("return PENALTY;"),
         splice.source,
     );
@@ -224,7 +250,7 @@ pub(crate) fn setup<D: Dim>(
     };
     // Kernels that locate box centres on the grid (they bind `boxes`).
     let cells = |label: &str, body: &str, n: usize| broad(label, &format!("{CELLS}{body}"), n);
-    let kernels = [
+    let mut kernels = vec![
         broad("moved", include_str!("shaders/broad_moved.wgsl"), nn)
             .const_real("LIMIT2", half * half)
             .bind("coords", setup.coords(), Access::Read)
@@ -292,7 +318,8 @@ pub(crate) fn setup<D: Dim>(
                 .const_u32("SLOT_FIRST", setup.slot_first())
                 .const_u32("MODEL_KIND", splice.kinds[0])
                 .const_u32("MODEL_AT", 0)
-                .const_real("PENALTY", model.normal_penalty()),
+                .const_real("PENALTY", model.normal_penalty())
+                .const_u32("REGIONS", regions as u32),
         )
         .bind("coords", setup.coords(), Access::Read)
         .bind("disp", setup.displacement(), Access::Read)
@@ -305,8 +332,25 @@ pub(crate) fn setup<D: Dim>(
         .bind("bond_list", bond_list, Access::Read)
         .bind("broken", broken, Access::Read)
         .bind("model_data", model_data, Access::Read)
+        .bind("elem_vertex", elem_vertex, Access::Read)
+        .bind("vertex_flags", vertex_flags, Access::Read)
         .bind("slots", setup.slots(), Access::ReadWrite),
     ];
+    if regions {
+        // The vertex flags, after the joints and before the forces.
+        let vertices = common(Kernel::new(
+            "contact vertices",
+            include_str!("shaders/contact_vertices.wgsl"),
+            nv,
+        ))
+        .bind("vertex_ptr", vertex_ptr, Access::Read)
+        .bind("vertex_faces", vertex_faces, Access::Read)
+        .bind("vertex_static", vertex_static, Access::Read)
+        .bind("broken", broken, Access::Read)
+        .bind("vertex_flags", vertex_flags, Access::ReadWrite);
+        let at = kernels.len() - 1;
+        kernels.insert(at, vertices);
+    }
     for k in kernels {
         setup.kernel(Phase::Forces, k)?;
     }
@@ -318,7 +362,7 @@ mod tests {
     use crate::{Contact, ContactModel, ContactStress};
     use pcdc_compute::gpu::{offline_kernel_sources, validate_wgsl};
     use pcdc_compute::{ComputeError, Physics, Precision};
-    use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh};
+    use pcdc_mesh::{builders, split_nodes, Dim, Dim2, Dim3, Mesh, Range};
 
     fn two_blocks() -> Mesh<Dim2> {
         let a = builders::rectangle(0.0, 0.0, 0.1, 0.1, 0.02).unwrap();
@@ -340,7 +384,16 @@ mod tests {
     /// Validates every contact kernel of `contact` on `mesh` with naga; checks that the
     /// forces kernel is the one of the mesh's dimension.
     fn validate_all<D: Dim>(mesh: &Mesh<D>, contact: Contact, p: Precision) {
-        let physics: Vec<Box<dyn Physics<D>>> = vec![Box::new(contact)];
+        validate_n(mesh, vec![Box::new(contact)], p, 8);
+    }
+
+    /// Validates the contact kernels among `physics`, expecting `n` of them.
+    fn validate_n<D: Dim>(
+        mesh: &Mesh<D>,
+        physics: Vec<Box<dyn Physics<D>>>,
+        p: Precision,
+        n: usize,
+    ) {
         let all = offline_kernel_sources(mesh, physics, p).unwrap();
         let ours: Vec<_> = all
             .iter()
@@ -348,7 +401,7 @@ mod tests {
             .collect();
         assert_eq!(
             ours.len(),
-            8,
+            n,
             "{:?}",
             all.iter().map(|k| &k.0).collect::<Vec<_>>()
         );
@@ -387,6 +440,54 @@ mod tests {
             let ne = m3.n_elements();
             let surface = Contact::new(1e10).surface_defaults(vec![25.0; ne], vec![1e10; ne]);
             validate_all(&m3, surface, p);
+        }
+    }
+
+    /// Faces whose broken flag is read by the bonded-region kernels (the test owner).
+    #[derive(Debug)]
+    struct BrokenFlags;
+    impl<D: Dim> Physics<D> for BrokenFlags {
+        fn name(&self) -> &str {
+            "broken flags"
+        }
+        fn fields(&self, _: &Mesh<D>) -> Vec<pcdc_compute::FieldUse> {
+            vec![pcdc_compute::FieldUse {
+                place: Some(pcdc_compute::Place::Face),
+                components: Some(1),
+                ..pcdc_compute::FieldUse::named("broken", pcdc_compute::FieldAccess::Own)
+            }]
+        }
+        fn init(&mut self, _: &mut pcdc_compute::InitContext<'_, D>) -> Result<(), ComputeError> {
+            Ok(())
+        }
+        fn compute_forces(
+            &mut self,
+            _: &mut pcdc_compute::ForceContext<'_, D>,
+        ) -> Result<(), ComputeError> {
+            Ok(())
+        }
+        fn gpu_setup(
+            &mut self,
+            _: &mut pcdc_compute::gpu::GpuSetup<'_, D>,
+        ) -> Result<(), ComputeError> {
+            Ok(())
+        }
+    }
+
+    /// With bonded interfaces the vertex-flag kernel joins (9 kernels), 2D and 3D, f64
+    /// and f32, and every kernel validates.
+    #[test]
+    fn bonded_region_kernels_validate() {
+        let m2 = split_nodes(&two_blocks(), &Range::All).unwrap();
+        let m3 = split_nodes(&two_cubes(), &Range::All).unwrap();
+        for p in [Precision::F64, Precision::F32] {
+            let c = || {
+                Contact::new(1e10)
+                    .friction(30.0, 1e11)
+                    .bonded_interfaces("broken")
+            };
+            validate_n(&m2, vec![Box::new(BrokenFlags), Box::new(c())], p, 9);
+            validate_n(&m3, vec![Box::new(BrokenFlags), Box::new(c())], p, 9);
         }
     }
 

@@ -35,6 +35,7 @@
 // Index loops mirror the formulas.
 #![allow(clippy::needless_range_loop)]
 
+mod exclusion;
 mod gpu;
 mod model;
 mod physics;

@@ -45,7 +45,11 @@
 //! Elements bonded by an intact cohesive joint do not contact each other once the bonds
 //! are declared, from the mesh's interfaces with [`Contact::bonded_interfaces`] or as
 //! lists with [`Contact::bonded_pairs`]; the pair becomes a contact pair as soon as the
-//! joint's broken-face flag is set (the cohesive crate publishes it).
+//! joint's broken-face flag is set (the cohesive crate publishes it). With bonds
+//! declared, contact also skips pairs inside intact rock: pairs sharing a vertex whose
+//! bonds all hold, and every pair with a sealed element (all its vertices surrounded by
+//! intact bonds); they enter the narrow phase once a joint at one of their vertices
+//! breaks. The rules and why they lose no contact are in the `exclusion` module.
 //!
 //! The contact law (eq. 59-61) sees per pair a trial normal stress σ_try = |F_n| / A over
 //! a contact measure A, a contact length h and a scalar slip increment:
@@ -74,6 +78,7 @@ use rayon::prelude::*;
 
 use std::sync::Arc;
 
+use crate::exclusion::BondedRegions;
 use crate::model::{ContactDamping, ContactModel, Friction, MohrCoulombContact};
 use crate::{tet_pair_force, triangle_pair_force, PairForce2, PairForce3};
 
@@ -266,6 +271,8 @@ pub struct Contact {
     /// Candidate capacity per element set by the user.
     capacity: Option<usize>,
     bonds: Option<Bonds>,
+    /// Vertex topology of the bonded regions (set by init when bonds are declared).
+    regions: Option<BondedRegions>,
     skin_used: f64,
     /// The state fields (set by init).
     ids: Option<StateIds>,
@@ -325,6 +332,7 @@ impl Contact {
             skin: None,
             capacity: None,
             bonds: None,
+            regions: None,
             skin_used: 0.0,
             ids: None,
         }
@@ -1003,6 +1011,7 @@ impl<D: Dim> Physics<D> for Contact {
                 l.sort_unstable();
             }
             b.per_element = per;
+            self.regions = Some(BondedRegions::new(ctx.mesh, &b.elements, &b.faces));
         }
         if self.capacity == Some(0) {
             return Err(ComputeError::param(
@@ -1054,6 +1063,7 @@ impl<D: Dim> Physics<D> for Contact {
                 .map(|b| (b.per_element.as_slice(), b.field.as_str())),
             capacity: ids.capacity,
             stride: ids.stride,
+            regions: self.regions.as_ref(),
         };
         crate::gpu::setup(input, setup)
     }
@@ -1166,6 +1176,11 @@ impl<D: Dim> Physics<D> for Contact {
                     (n, c, h, &[])
                 }
             };
+        // Where contact can happen this step (see the `exclusion` module).
+        if let Some(r) = &mut self.regions {
+            ctx.backend.install(|| r.update(broken));
+        }
+        let regions = self.regions.as_ref();
         // Element e's list: the first n entries of its row (n checked on restore; the
         // clamp keeps a hand-edited count in bounds).
         let list = |e: usize| {
@@ -1191,9 +1206,15 @@ impl<D: Dim> Physics<D> for Contact {
                     .zip(hist.par_chunks_mut(cap * stride))
                     .enumerate()
                     .for_each(|(e, (slot, slip))| {
+                        if regions.is_some_and(|r| r.sealed(e)) {
+                            return;
+                        }
                         let me = Self::element_xyz(kin, e);
                         for (k, &f) in list(e).iter().enumerate() {
                             let f = f as usize;
+                            if regions.is_some_and(|r| r.skips(e, f)) {
+                                continue;
+                            }
                             if let Some(face) = bonds.and_then(|b| b.face(e, f)) {
                                 if broken[face] == 0.0 {
                                     continue;
@@ -1241,9 +1262,16 @@ impl<D: Dim> Physics<D> for Contact {
                 .zip(hist.par_chunks_mut(cap * stride))
                 .enumerate()
                 .for_each(|(e, (slot, slip))| {
+                    // Inside intact rock nothing can touch (see the `exclusion` module).
+                    if regions.is_some_and(|r| r.sealed(e)) {
+                        return;
+                    }
                     let me = Self::element_xy(kin, e);
                     for (k, &f) in list(e).iter().enumerate() {
                         let f = f as usize;
+                        if regions.is_some_and(|r| r.skips(e, f)) {
+                            continue;
+                        }
                         // Bonded neighbours interact through their joint until it breaks.
                         if let Some(face) = bonds.and_then(|b| b.face(e, f)) {
                             if broken[face] == 0.0 {

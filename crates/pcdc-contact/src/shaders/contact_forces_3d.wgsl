@@ -139,9 +139,16 @@ fn is_zero(pair: PairForce) -> bool {
 fn kernel(e: u32) {
     var own: Tet;
     let me = element_xyz(e);
-    let n = min(u32(ncand[e]), CAP);
+    var n = min(u32(ncand[e]), CAP);
+    // Inside intact rock nothing can touch (regions.wgsl).
+    if sealed(e) {
+        n = 0u;
+    }
     for (var k = 0u; k < n; k = k + 1u) {
         let f = u32(cand[e * CAP + k]);
+        if sealed(f) || share_intact_vertex(e, f) {
+            continue;
+        }
         // Bonded neighbours interact through their joint until it breaks.
         let face = bond_face(e, f);
         if face != 0xffffffffu {
