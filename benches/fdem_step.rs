@@ -16,15 +16,18 @@
 //!
 //! Run: `cargo bench --bench fdem_step`. Criterion reports elements/s = triangle-steps/s;
 //! joint-steps/s = triangle-steps/s x joints/triangles (about 1.5), printed once per mesh.
+//!
+//! 3D rows `tet4_...`: the cuboid of tetrahedra of `pcdc_validation::scenes::benchmark`
+//! (12 000 and 49 152 tetrahedra, joints on every interior face), joints only and with
+//! contact, 1 thread and all threads.
+//!
+//! The scenes are built by `pcdc_validation::scenes::benchmark` (also used by the
+//! `step_profile` example).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams};
 use pcdc_compute::{Backend, Precision, Simulation};
-use pcdc_contact::Contact;
-use pcdc_mech::{Boundary, LinearElastic, Mechanics};
-use pcdc_mesh::{builders, split_nodes, Dim2, Range};
-
-const E: f64 = 30e9;
+use pcdc_mesh::Dim2;
+use pcdc_validation::scenes::benchmark::{fdem_block_2d, fdem_cuboid_3d};
 
 /// Steps per measured GPU iteration.
 const GPU_STEPS: u64 = 20;
@@ -34,41 +37,7 @@ fn scene(cells_x: usize, backend: Backend) -> Simulation<Dim2> {
 }
 
 fn scene_with(cells_x: usize, backend: Backend, contact: bool) -> Simulation<Dim2> {
-    let h = 0.05 / cells_x as f64;
-    let mesh = builders::rectangle(0.0, 0.0, 0.05, 0.10, h).unwrap();
-    let split = split_nodes(&mesh, &Range::All).unwrap();
-    let czm = IntrinsicCzmParams {
-        friction_deg: 30.0,
-        cohesion: 10e6,
-        tensile_strength: 2e6,
-        gf1: 0.5,
-        gf2: 5.0,
-        penalty_open: 10.0 * E,
-        penalty_shear: 10.0 * E,
-        penalty_overlap: 100.0 * E,
-    }
-    .build()
-    .unwrap();
-    let rock = LinearElastic::new(E, 0.25, 2600.0).unwrap();
-    let c_p = ((rock.lambda() + 2.0 * rock.shear()) / 2600.0).sqrt();
-    let mut b = Simulation::builder(split, backend)
-        .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new().model(Range::All, czm));
-    if contact {
-        b = b.physics(
-            Contact::new(10.0 * E)
-                .friction(30.0, 10.0 * E)
-                .bonded_interfaces(pcdc_cohesive::BROKEN_FACE),
-        );
-    }
-    b.physics(
-        Boundary::new()
-            .velocity(Range::group("bottom"), [None, Some(0.0.into()), None])
-            .velocity(Range::group("top"), [None, Some((-0.05).into()), None]),
-    )
-    .time_step(0.05 * h / c_p)
-    .build()
-    .unwrap()
+    fdem_block_2d(cells_x, backend, contact).unwrap()
 }
 
 fn bench(c: &mut Criterion) {
@@ -123,6 +92,24 @@ fn bench(c: &mut Criterion) {
             g.bench_function(format!("tri3_{}k_contact_threads_{t}", n / 1000), |b| {
                 b.iter(|| sim.step().unwrap())
             });
+        }
+    }
+    // The 3D scene (tetrahedra, joints on every interior face, with and without contact).
+    for cells in [10, 16] {
+        for contact in [false, true] {
+            for &t in &threads {
+                let mut sim = fdem_cuboid_3d(cells, Backend::cpu(t).unwrap(), contact).unwrap();
+                let n = sim.mesh().n_elements();
+                let what = if contact { "contact" } else { "joints" };
+                if t == 1 {
+                    let joints = sim.field(pcdc_cohesive::JOINT_DAMAGE).unwrap().len();
+                    eprintln!("fdem_step 3D {what}: {n} tetrahedra, {joints} joints ({:.3} per tetrahedron), {:.0} B per tetrahedron in the simulation state", joints as f64 / n as f64, sim.state_bytes() as f64 / n as f64);
+                }
+                g.throughput(Throughput::Elements(n as u64));
+                g.bench_function(format!("tet4_{}k_{what}_threads_{t}", n / 1000), |b| {
+                    b.iter(|| sim.step().unwrap())
+                });
+            }
         }
     }
     for p in [Precision::F64, Precision::F32] {

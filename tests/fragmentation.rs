@@ -45,6 +45,26 @@ fn fragments_in_a_box_stay_stable_for_100k_steps() {
     );
 }
 
+/// CPU results do not depend on the thread count: the shattering block (broken joints,
+/// contact between fragments, the per-step sealed flags and boxes of contact) on 1 and 2
+/// threads, bit for bit after 8 000 steps.
+#[test]
+fn fragmentation_is_bit_identical_across_thread_counts() {
+    let p = Params {
+        size: 0.01,
+        steps: 8_000,
+        check_every: 2_000,
+    };
+    let one = run(&Backend::cpu(1).unwrap(), &p).unwrap();
+    let two = run(&Backend::cpu(2).unwrap(), &p).unwrap();
+    assert!(
+        one.broken > 0,
+        "nothing broke: the run does not test contact"
+    );
+    assert_eq!(one.broken, two.broken);
+    assert_eq!(one.state_hash, two.state_hash, "1 and 2 threads differ");
+}
+
 /// The same scene on the GPU (f64): 10 000 steps at 1 cm (the impact and the shattering)
 /// in CI; the energy balance (accumulated on the device) and the penetration stay within
 /// the bounds. The full 100 000 steps: `cargo test --release --test fragmentation --

@@ -228,13 +228,6 @@ impl BondedRegions {
             .iter()
             .any(|v| vf.contains(v) && self.flags[*v as usize] & INTACT != 0)
     }
-
-    /// Whether the pair (`e`, `f`) is skipped by rules 2 and 3 (rule 1, the bonded face,
-    /// is checked by the caller).
-    #[inline]
-    pub fn skips(&self, e: usize, f: usize) -> bool {
-        self.sealed(f) || self.share_intact_vertex(e, f)
-    }
 }
 
 /// A vertex's flags from its static bits and whether all its bonds hold.

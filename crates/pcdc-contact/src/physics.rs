@@ -273,9 +273,29 @@ pub struct Contact {
     bonds: Option<Bonds>,
     /// Vertex topology of the bonded regions (set by init when bonds are declared).
     regions: Option<BondedRegions>,
+    /// Per-step scratch (derived from the positions and the vertex flags every step).
+    scratch: StepScratch,
     skin_used: f64,
     /// The state fields (set by init).
     ids: Option<StateIds>,
+}
+
+/// What every element's candidates look up once per step: whether the element is sealed
+/// (nothing can touch it, see the `exclusion` module) and, if not, the box of its current
+/// corners (lows then highs, stride 2 D), so that the first test of the pair potential
+/// costs a few loads per candidate.
+#[derive(Debug, Default)]
+struct StepScratch {
+    sealed: Vec<bool>,
+    boxes: Vec<f64>,
+}
+
+/// Whether two boxes (lows then highs, `d` components each) are apart; touching counts
+/// as apart, exactly the first test of [`triangle_pair_force`] and [`tet_pair_force`],
+/// whose force is then zero.
+#[inline]
+fn boxes_apart(a: &[f64], b: &[f64], d: usize) -> bool {
+    (0..d).any(|k| a[d + k] <= b[k] || b[d + k] <= a[k])
 }
 
 /// The contact physics' fields and their strides (see the module docs).
@@ -333,6 +353,7 @@ impl Contact {
             capacity: None,
             bonds: None,
             regions: None,
+            scratch: StepScratch::default(),
             skin_used: 0.0,
             ids: None,
         }
@@ -1139,13 +1160,18 @@ impl<D: Dim> Physics<D> for Contact {
         let limit2 = (0.5 * self.skin_used).powi(2);
         let dim = D::D;
         let reference = ctx.fields.get(ids.reference);
-        let moved = (0..kin.mesh.n_nodes()).any(|n| {
-            let mut d2 = 0.0;
-            for k in 0..dim {
-                let dk = kin.x(n, k) - reference[dim * n + k];
-                d2 += dk * dk;
-            }
-            d2.is_nan() || d2 > limit2
+        let nn = kin.mesh.n_nodes();
+        let moved = ctx.backend.install(|| {
+            (0..nn.div_ceil(4096)).into_par_iter().any(|b| {
+                (4096 * b..(4096 * (b + 1)).min(nn)).any(|n| {
+                    let mut d2 = 0.0;
+                    for k in 0..dim {
+                        let dk = kin.x(n, k) - reference[dim * n + k];
+                        d2 += dk * dk;
+                    }
+                    d2.is_nan() || d2 > limit2
+                })
+            })
         });
         if moved {
             let fresh = ctx.backend.install(|| self.build(kin));
@@ -1181,6 +1207,39 @@ impl<D: Dim> Physics<D> for Contact {
             ctx.backend.install(|| r.update(broken));
         }
         let regions = self.regions.as_ref();
+        // Sealed flags and current boxes, once per element and step.
+        let ne = kin.mesh.n_elements();
+        let mut scratch = std::mem::take(&mut self.scratch);
+        scratch.sealed.resize(ne, false);
+        scratch.boxes.resize(ne * 2 * dim, 0.0);
+        ctx.backend.install(|| {
+            scratch
+                .sealed
+                .par_iter_mut()
+                .zip(scratch.boxes.par_chunks_mut(2 * dim))
+                .enumerate()
+                .with_min_len(1024)
+                .for_each(|(e, (sealed, b))| {
+                    *sealed = regions.is_some_and(|r| r.sealed(e));
+                    if *sealed {
+                        return;
+                    }
+                    let nodes = kin.mesh.element(e);
+                    for k in 0..dim {
+                        let x0 = kin.x(nodes[0] as usize, k);
+                        let (mut lo, mut hi) = (x0, x0);
+                        for &n in &nodes[1..] {
+                            let x = kin.x(n as usize, k);
+                            lo = lo.min(x);
+                            hi = hi.max(x);
+                        }
+                        b[k] = lo;
+                        b[dim + k] = hi;
+                    }
+                })
+        });
+        let (sealed, boxes) = (&scratch.sealed, &scratch.boxes);
+        let bx = |e: usize| &boxes[2 * dim * e..2 * dim * (e + 1)];
         // Element e's list: the first n entries of its row (n checked on restore; the
         // clamp keeps a hand-edited count in bounds).
         let list = |e: usize| {
@@ -1206,13 +1265,24 @@ impl<D: Dim> Physics<D> for Contact {
                     .zip(hist.par_chunks_mut(cap * stride))
                     .enumerate()
                     .for_each(|(e, (slot, slip))| {
-                        if regions.is_some_and(|r| r.sealed(e)) {
+                        if sealed[e] {
                             return;
                         }
                         let me = Self::element_xyz(kin, e);
                         for (k, &f) in list(e).iter().enumerate() {
                             let f = f as usize;
-                            if regions.is_some_and(|r| r.skips(e, f)) {
+                            if sealed[f] {
+                                continue;
+                            }
+                            let state = &mut slip[k * stride..k * stride + ns];
+                            if boxes_apart(bx(e), bx(f), 3) {
+                                // The potential's own first test, before the costlier
+                                // exclusion checks: no force, fresh history.
+                                model.separate(state);
+                                continue;
+                            }
+                            let other = Self::element_xyz(kin, f);
+                            if regions.is_some_and(|r| r.share_intact_vertex(e, f)) {
                                 continue;
                             }
                             if let Some(face) = bonds.and_then(|b| b.face(e, f)) {
@@ -1220,14 +1290,12 @@ impl<D: Dim> Physics<D> for Contact {
                                     continue;
                                 }
                             }
-                            let other = Self::element_xyz(kin, f);
                             let (c, t, ci, ti) = if e < f {
                                 (&me, &other, e, f)
                             } else {
                                 (&other, &me, f, e)
                             };
                             let mut pair = tet_pair_force(c, t, model.pair_penalty(ci, ti));
-                            let state = &mut slip[k * stride..k * stride + ns];
                             if pair == PairForce3::default() {
                                 // Not touching (most candidates): no force, fresh history.
                                 model.separate(state);
@@ -1244,6 +1312,7 @@ impl<D: Dim> Physics<D> for Contact {
                         }
                     })
             });
+            self.scratch = scratch;
             return Ok(());
         }
         let mean_edge = |e: usize| {
@@ -1263,13 +1332,24 @@ impl<D: Dim> Physics<D> for Contact {
                 .enumerate()
                 .for_each(|(e, (slot, slip))| {
                     // Inside intact rock nothing can touch (see the `exclusion` module).
-                    if regions.is_some_and(|r| r.sealed(e)) {
+                    if sealed[e] {
                         return;
                     }
                     let me = Self::element_xy(kin, e);
                     for (k, &f) in list(e).iter().enumerate() {
                         let f = f as usize;
-                        if regions.is_some_and(|r| r.skips(e, f)) {
+                        if sealed[f] {
+                            continue;
+                        }
+                        let state = &mut slip[k * stride..k * stride + ns];
+                        if boxes_apart(bx(e), bx(f), 2) {
+                            // The potential's own first test, before the costlier
+                            // exclusion checks: no force, fresh history.
+                            model.separate(state);
+                            continue;
+                        }
+                        let other = Self::element_xy(kin, f);
+                        if regions.is_some_and(|r| r.share_intact_vertex(e, f)) {
                             continue;
                         }
                         // Bonded neighbours interact through their joint until it breaks.
@@ -1278,7 +1358,6 @@ impl<D: Dim> Physics<D> for Contact {
                                 continue;
                             }
                         }
-                        let other = Self::element_xy(kin, f);
                         // Canonical order: the lower index is the contactor.
                         let (c, t, ci, ti) = if e < f {
                             (&me, &other, e, f)
@@ -1286,7 +1365,6 @@ impl<D: Dim> Physics<D> for Contact {
                             (&other, &me, f, e)
                         };
                         let mut pair = triangle_pair_force(c, t, model.pair_penalty(ci, ti));
-                        let state = &mut slip[k * stride..k * stride + ns];
                         if pair == PairForce2::default() {
                             // Not touching (most candidates): no force, fresh history.
                             model.separate(state);
@@ -1302,6 +1380,7 @@ impl<D: Dim> Physics<D> for Contact {
                     }
                 })
         });
+        self.scratch = scratch;
         Ok(())
     }
 }

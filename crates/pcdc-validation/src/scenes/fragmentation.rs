@@ -95,6 +95,9 @@ pub struct Outcome {
     pub dt: f64,
     /// Wall time (s).
     pub wall_s: f64,
+    /// FNV-1a hash of the bits of the final displacements and velocities: equal hashes
+    /// mean bit-identical runs (e.g. on different thread counts).
+    pub state_hash: u64,
     /// (step, relative excess, relative penetration) at each check.
     pub history: Vec<(u64, f64, f64)>,
 }
@@ -178,6 +181,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         steps: 0,
         dt: sim.dt(),
         wall_s: 0.0,
+        state_hash: 0,
         history: Vec::new(),
     };
     let every = p.check_every.max(1);
@@ -213,6 +217,14 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         .filter(|&&d| d >= 1.0)
         .count();
     out.steps = sim.state.step;
+    let kin = sim.kinematics();
+    out.state_hash = kin
+        .u
+        .iter()
+        .chain(kin.v)
+        .fold(0xcbf2_9ce4_8422_2325, |h, x| {
+            (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3)
+        });
     out.wall_s = start.elapsed().as_secs_f64();
     Ok(out)
 }

@@ -3,10 +3,13 @@
 //! full size and print the `RESULT` line; tests run them at reduced size and assert the
 //! same tolerance.
 //!
+//! [`benchmark`] holds the standard FDEM benchmark scenes of the speed measurements.
+//!
 //! The laboratory tests [`ucs`] and [`brazilian`] share one platen-test set-up
 //! ([`platen_test`]) and can be written as TOML scene files ([`file`](mod@file)); their upper
 //! bounds and memory guard are in [`limits`].
 
+pub mod benchmark;
 pub mod block_sliding;
 pub mod brazilian;
 pub mod direct_tension;
