@@ -512,6 +512,14 @@ impl<D: Dim> Simulation<D> {
         if self.gpu.is_some() {
             return self.run(1);
         }
+        // The whole step on the pool: every pass's `install` then runs in place instead
+        // of handing over to the pool and back (about 20 µs each, a sixth of a 10k step).
+        let backend = self.backend.clone();
+        backend.install(|| self.cpu_step())
+    }
+
+    /// One CPU step (called on the backend's pool).
+    fn cpu_step(&mut self) -> Result<(), ComputeError> {
         self.physics_forces()?;
         self.energy_before_update();
         self.gather(true);
@@ -530,10 +538,13 @@ impl<D: Dim> Simulation<D> {
             self.gpu = Some(gpu);
             return r;
         }
-        for _ in 0..n {
-            self.step()?;
-        }
-        Ok(())
+        let backend = self.backend.clone();
+        backend.install(|| {
+            for _ in 0..n {
+                self.cpu_step()?;
+            }
+            Ok(())
+        })
     }
 
     /// Advances until `time` (s) is reached (the last step may overshoot by < dt).
@@ -546,10 +557,13 @@ impl<D: Dim> Simulation<D> {
             }
             return self.run(n);
         }
-        while self.state.time < time {
-            self.step()?;
-        }
-        Ok(())
+        let backend = self.backend.clone();
+        backend.install(|| {
+            while self.state.time < time {
+                self.cpu_step()?;
+            }
+            Ok(())
+        })
     }
 
     /// Device-memory bytes one step streams on the GPU backend (every bound buffer read
