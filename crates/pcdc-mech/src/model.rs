@@ -171,18 +171,6 @@ pub struct LinearElastic {
     damp_factor: f64,
     friction: f64,
     contact_penalty: Option<f64>,
-    /// (λ, μ), derived from E and ν when the model is built (neither can change after),
-    /// so the per-step update pays no division.
-    #[serde(skip_serializing)]
-    lame: (f64, f64),
-}
-
-/// Lamé's λ and μ from E and ν (eq. 24).
-fn lame(young: f64, poisson: f64) -> (f64, f64) {
-    (
-        young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson)),
-        young / (2.0 * (1.0 + poisson)),
-    )
 }
 
 /// The serialised form of [`LinearElastic`] (same keys), checked before it becomes one.
@@ -211,7 +199,6 @@ impl TryFrom<RawLinearElastic> for LinearElastic {
             damp_factor: r.damp_factor,
             friction: r.friction,
             contact_penalty: r.contact_penalty,
-            lame: lame(r.young, r.poisson),
         };
         m.check()?;
         Ok(m)
@@ -228,7 +215,6 @@ impl LinearElastic {
             damp_factor: 0.0,
             friction: 0.0,
             contact_penalty: None,
-            lame: lame(young, poisson),
         };
         m.check()?;
         Ok(m)
@@ -359,12 +345,12 @@ impl LinearElastic {
 
     /// Lamé's first parameter λ = Eν/((1+ν)(1-2ν)) (eq. 23), Pa.
     pub fn lambda(&self) -> f64 {
-        self.lame.0
+        self.young * self.poisson / ((1.0 + self.poisson) * (1.0 - 2.0 * self.poisson))
     }
 
     /// Shear modulus μ = G = E/(2(1+ν)) (eq. 24), Pa.
     pub fn shear(&self) -> f64 {
-        self.lame.1
+        self.young / (2.0 * (1.0 + self.poisson))
     }
 
     /// Bulk modulus K = λ + 2G/3, Pa.
@@ -374,7 +360,7 @@ impl LinearElastic {
 
     /// σ = λ tr(ε) I + 2μ ε for a strain tensor.
     pub fn stress_of(&self, e: &Sym6) -> Sym6 {
-        let (l, m) = self.lame;
+        let (l, m) = (self.lambda(), self.shear());
         let tr = e[0] + e[1] + e[2];
         [
             l * tr + 2.0 * m * e[0],
