@@ -30,8 +30,9 @@
 
 use std::sync::Arc;
 
+use pcdc_compute::coupling::CouplingInputs;
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
-use pcdc_compute::{Backend, FieldKey, FieldUse, Location};
+use pcdc_compute::{Backend, FieldKey, FieldUse};
 use pcdc_compute::{
     ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
     StableStep,
@@ -126,49 +127,7 @@ pub struct CohesiveJoints {
     rule: Vec<([f64; 3], f64)>,
     n_state: usize,
     ids: Option<[FieldId; 6]>,
-    coupling: Coupling,
-}
-
-/// One coupling field read by the joint models, as found in the field store at init.
-#[derive(Clone, Copy, Debug)]
-struct CouplingField {
-    id: FieldId,
-    /// A node field (mean of the joint's face nodes); else an element field (mean of
-    /// its two elements).
-    node: bool,
-    /// Values per entity.
-    components: usize,
-}
-
-/// The coupling inputs of the joint models (all empty when no model declares any).
-#[derive(Clone, Debug, Default)]
-struct Coupling {
-    /// The keys the models declare, each once, in order of first declaration.
-    keys: Vec<FieldKey>,
-    /// The fields of `keys`, after init.
-    fields: Vec<CouplingField>,
-    /// Per model: indices into `fields` of its keys, in its declaration order.
-    of_model: Vec<Vec<usize>>,
-    /// Per model: its number of coupling values (the components of its keys).
-    len_of_model: Vec<usize>,
-    /// Values per joint in `values`: the largest of `len_of_model` (0: no coupling).
-    stride: usize,
-    /// Each joint's values in its model's order, `stride` per joint, refreshed at the
-    /// start of every force evaluation (scratch, not state).
-    values: Vec<f64>,
-}
-
-/// The coupling keys the models declare, each once, in order of first declaration.
-fn coupling_keys<'a>(models: impl Iterator<Item = &'a Arc<dyn JointModel>>) -> Vec<FieldKey> {
-    let mut keys: Vec<FieldKey> = Vec::new();
-    for m in models {
-        for k in m.coupling() {
-            if !keys.contains(k) {
-                keys.push(*k);
-            }
-        }
-    }
-    keys
+    coupling: CouplingInputs,
 }
 
 impl Default for CohesiveJoints {
@@ -193,7 +152,7 @@ impl CohesiveJoints {
             rule: Vec::new(),
             n_state: 1,
             ids: None,
-            coupling: Coupling::default(),
+            coupling: CouplingInputs::default(),
         }
     }
 
@@ -233,66 +192,7 @@ impl CohesiveJoints {
         self.rule.len() * self.n_state
     }
 
-    /// The coupling inputs of the resolved models: the fields they read (node or element
-    /// fields, declared by their owners), each model's indices and value count, and the
-    /// value buffer (allocated only when a model reads a field).
-    fn resolve_coupling(&self, fields: &FieldStore) -> Result<Coupling, ComputeError> {
-        let keys = coupling_keys(self.models.iter());
-        if keys.is_empty() {
-            return Ok(Coupling::default());
-        }
-        let mut resolved = Vec::with_capacity(keys.len());
-        for k in &keys {
-            let id = fields.id(k)?;
-            let spec = fields.spec(id);
-            let node = match spec.location {
-                Location::Node => true,
-                Location::Element => false,
-                other => {
-                    let model = self
-                        .models
-                        .iter()
-                        .find(|m| m.coupling().contains(k))
-                        .map_or("?", |m| m.name());
-                    return Err(ComputeError::param(
-                        format!("coupling field '{k}' of joint model '{model}'"),
-                        format!("{other:?}"),
-                        "a joint model reads node or element fields only",
-                    ));
-                }
-            };
-            resolved.push(CouplingField {
-                id,
-                node,
-                components: spec.components,
-            });
-        }
-        let of_model: Vec<Vec<usize>> = self
-            .models
-            .iter()
-            .map(|m| {
-                m.coupling()
-                    .iter()
-                    .filter_map(|k| keys.iter().position(|u| u == k))
-                    .collect()
-            })
-            .collect();
-        let len_of_model: Vec<usize> = of_model
-            .iter()
-            .map(|ix| ix.iter().map(|&i| resolved[i].components).sum())
-            .collect();
-        let stride = len_of_model.iter().copied().max().unwrap_or(0);
-        Ok(Coupling {
-            keys,
-            fields: resolved,
-            of_model,
-            len_of_model,
-            stride,
-            values: vec![0.0; self.joints.len() * stride],
-        })
-    }
-
-    /// Fills `values` (stride [`Coupling::stride`] per joint) with every joint's
+    /// Fills `values` (stride [`CouplingInputs::stride`] per joint) with every joint's
     /// coupling values in its model's order: the mean of the joint's face nodes (side A,
     /// then side B, summed in that order, then divided by 2 NPF) for a node field, the
     /// mean of its two elements ((0 + v_A) + v_B) / 2 for an element field. The GPU's
@@ -342,7 +242,7 @@ impl CohesiveJoints {
     /// computes every coupling field's values at the joint (the operations of
     /// [`Self::gather_coupling`]) and returns those of the joint's model in its order
     /// (zero beyond its count), through the table `joint_coupling`
-    /// ([`Self::bind_coupling`]). With coupling, a `joint_info` row ends with the
+    /// ([`CouplingInputs::bind`]). With coupling, a `joint_info` row ends with the
     /// joint's model index and its two elements (A, B).
     fn coupling_wgsl<D: Dim>(&self) -> String {
         let npf = D::NODES_PER_FACE;
@@ -371,41 +271,6 @@ impl CohesiveJoints {
             2 * npf + 4
         ));
         src
-    }
-
-    /// Binds the coupling fields (`cpl0`, `cpl1`, ... in the order of
-    /// [`Coupling::keys`], read only) and the table `joint_coupling`: per model its
-    /// value count and the offset of its map, then the maps (per value, its index in
-    /// `joint_coupling_of`'s `all`).
-    fn bind_coupling<D: Dim>(
-        &self,
-        setup: &mut GpuSetup<'_, D>,
-        mut kernel: Kernel,
-    ) -> Result<Kernel, ComputeError> {
-        let mut first = Vec::with_capacity(self.coupling.fields.len());
-        let mut at = 0u32;
-        for f in &self.coupling.fields {
-            first.push(at);
-            at += f.components as u32;
-        }
-        let nm = self.models.len();
-        let mut table: Vec<u32> = Vec::with_capacity(2 * nm);
-        let mut maps: Vec<u32> = Vec::new();
-        for (m, ix) in self.coupling.of_model.iter().enumerate() {
-            table.push(self.coupling.len_of_model[m] as u32);
-            table.push((2 * nm + maps.len()) as u32);
-            for &u in ix {
-                let f = &self.coupling.fields[u];
-                maps.extend((0..f.components as u32).map(|c| first[u] + c));
-            }
-        }
-        table.extend(maps);
-        let table = setup.upload("joint coupling", GpuData::U32(table));
-        kernel = kernel.bind("joint_coupling", table, Access::Read);
-        for (i, k) in self.coupling.keys.iter().enumerate() {
-            kernel = kernel.bind(&format!("cpl{i}"), setup.field(k)?, Access::Read);
-        }
-        Ok(kernel)
     }
 
     /// Joint `j`'s opening, sliding and normal into `out` and, unless it is `broken`
@@ -544,7 +409,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         // when the joints' forces stage runs: at most one explicit step old, the same on
         // both backends.
         uses.extend(
-            coupling_keys(self.assignments.iter().map(|a| &a.1))
+            CouplingInputs::keys(self.assignments.iter().map(|a| a.1.coupling()))
                 .into_iter()
                 .map(|k| k.read_lagged::<D>()),
         );
@@ -648,7 +513,13 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
             }
         }
         self.ids = Some(ids);
-        self.coupling = self.resolve_coupling(ctx.fields)?;
+        let models: Vec<(&str, &[FieldKey])> = self
+            .models
+            .iter()
+            .map(|m| (m.name(), m.coupling()))
+            .collect();
+        self.coupling =
+            CouplingInputs::resolve(&models, ctx.fields, self.joints.len(), "joint model")?;
         ctx.register_slots(self.joints.nodes())?;
         Ok(())
     }
@@ -893,7 +764,8 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
             )
             .bind("slots", setup.slots(), Access::ReadWrite);
         let kernel = if coupled {
-            self.bind_coupling(setup, kernel)?
+            self.coupling
+                .bind(setup, kernel, "joint_coupling", "joint coupling")?
         } else {
             kernel
         };

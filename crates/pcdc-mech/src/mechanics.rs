@@ -13,12 +13,13 @@
 
 use std::sync::Arc;
 
+use pcdc_compute::coupling::CouplingInputs;
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase};
 use pcdc_compute::{
     names, ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics,
     Physics, StableStep,
 };
-use pcdc_compute::{Backend, FieldKey, FieldUse, Location};
+use pcdc_compute::{Backend, FieldKey, FieldUse};
 use pcdc_compute::{Entity, EntityKind};
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
@@ -77,50 +78,7 @@ pub struct Mechanics {
     n_state: usize,
     geo: ElementGeometry,
     ids: Option<Ids>,
-    coupling: Coupling,
-}
-
-/// One coupling field read by the models, as found in the field store at init.
-#[derive(Clone, Copy, Debug)]
-struct CouplingField {
-    id: FieldId,
-    /// A node field (interpolated: mean of the element's nodes); else an element field.
-    node: bool,
-    /// Values per entity.
-    components: usize,
-}
-
-/// The coupling inputs of the models (all empty when no model declares any).
-#[derive(Clone, Debug, Default)]
-struct Coupling {
-    /// The keys the models declare, each once, in order of first declaration.
-    keys: Vec<FieldKey>,
-    /// The fields of `keys`, after init.
-    fields: Vec<CouplingField>,
-    /// Per model: indices into `fields` of its keys, in its declaration order.
-    of_model: Vec<Vec<usize>>,
-    /// Per model: its number of coupling values (the components of its keys).
-    len_of_model: Vec<usize>,
-    /// Values per element in `values`: the largest of `len_of_model` (0: no coupling).
-    stride: usize,
-    /// Each element's values in its model's order, `stride` per element, refreshed at
-    /// the start of every force evaluation (scratch, not state).
-    values: Vec<f64>,
-}
-
-/// The coupling keys the models declare, each once, in order of first declaration.
-fn coupling_keys<'a>(
-    models: impl Iterator<Item = &'a Arc<dyn ConstitutiveModel>>,
-) -> Vec<FieldKey> {
-    let mut keys: Vec<FieldKey> = Vec::new();
-    for m in models {
-        for k in m.coupling() {
-            if !keys.contains(k) {
-                keys.push(*k);
-            }
-        }
-    }
-    keys
+    coupling: CouplingInputs,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -230,70 +188,11 @@ impl Mechanics {
         self.ids.expect("Mechanics used before init")
     }
 
-    /// The coupling inputs of the resolved models: the fields they read (node or element
-    /// fields, declared by their owners), each model's indices and value count, and the
-    /// value buffer (allocated only when a model reads a field).
-    fn resolve_coupling(&self, fields: &FieldStore, ne: usize) -> Result<Coupling, ComputeError> {
-        let keys = coupling_keys(self.models.iter());
-        if keys.is_empty() {
-            return Ok(Coupling::default());
-        }
-        let mut resolved = Vec::with_capacity(keys.len());
-        for k in &keys {
-            let id = fields.id(k)?;
-            let spec = fields.spec(id);
-            let node = match spec.location {
-                Location::Node => true,
-                Location::Element => false,
-                other => {
-                    let model = self
-                        .models
-                        .iter()
-                        .find(|m| m.coupling().contains(k))
-                        .map_or("?", |m| m.name());
-                    return Err(ComputeError::param(
-                        format!("coupling field '{k}' of constitutive model '{model}'"),
-                        format!("{other:?}"),
-                        "a model reads node or element fields only",
-                    ));
-                }
-            };
-            resolved.push(CouplingField {
-                id,
-                node,
-                components: spec.components,
-            });
-        }
-        let of_model: Vec<Vec<usize>> = self
-            .models
-            .iter()
-            .map(|m| {
-                m.coupling()
-                    .iter()
-                    .filter_map(|k| keys.iter().position(|u| u == k))
-                    .collect()
-            })
-            .collect();
-        let len_of_model: Vec<usize> = of_model
-            .iter()
-            .map(|ix| ix.iter().map(|&i| resolved[i].components).sum())
-            .collect();
-        let stride = len_of_model.iter().copied().max().unwrap_or(0);
-        Ok(Coupling {
-            keys,
-            fields: resolved,
-            of_model,
-            len_of_model,
-            stride,
-            values: vec![0.0; ne * stride],
-        })
-    }
-
     /// The WGSL of the coupling inputs (only with coupling): the `Coupling` alias and
     /// `coupling_of(e, mat)`, which computes every coupling field's values at element
     /// `e` (the operations of [`Self::gather_coupling`]) and returns those of material
     /// `mat`'s model in its order (zero beyond its count), through the table
-    /// `mat_coupling` ([`Self::bind_coupling`]).
+    /// `mat_coupling` ([`CouplingInputs::bind`]).
     fn coupling_wgsl<D: Dim>(&self) -> String {
         let npe = D::NODES_PER_ELEM;
         let total: usize = self.coupling.fields.iter().map(|f| f.components).sum();
@@ -326,42 +225,7 @@ impl Mechanics {
         src
     }
 
-    /// Binds the coupling fields (`cpl0`, `cpl1`, ... in the order of
-    /// [`Coupling::keys`], read only) and the table `mat_coupling`: per material its
-    /// value count and the offset of its map, then the maps (per value, its index in
-    /// `coupling_of`'s `all`).
-    fn bind_coupling<D: Dim>(
-        &self,
-        setup: &mut GpuSetup<'_, D>,
-        mut kernel: Kernel,
-    ) -> Result<Kernel, ComputeError> {
-        let mut first = Vec::with_capacity(self.coupling.fields.len());
-        let mut at = 0u32;
-        for f in &self.coupling.fields {
-            first.push(at);
-            at += f.components as u32;
-        }
-        let nm = self.models.len();
-        let mut table: Vec<u32> = Vec::with_capacity(2 * nm);
-        let mut maps: Vec<u32> = Vec::new();
-        for (m, ix) in self.coupling.of_model.iter().enumerate() {
-            table.push(self.coupling.len_of_model[m] as u32);
-            table.push((2 * nm + maps.len()) as u32);
-            for &u in ix {
-                let f = &self.coupling.fields[u];
-                maps.extend((0..f.components as u32).map(|c| first[u] + c));
-            }
-        }
-        table.extend(maps);
-        let table = setup.upload("material coupling", GpuData::U32(table));
-        kernel = kernel.bind("mat_coupling", table, Access::Read);
-        for (i, k) in self.coupling.keys.iter().enumerate() {
-            kernel = kernel.bind(&format!("cpl{i}"), setup.field(k)?, Access::Read);
-        }
-        Ok(kernel)
-    }
-
-    /// Fills `values` (stride [`Coupling::stride`] per element) with every element's
+    /// Fills `values` (stride [`CouplingInputs::stride`] per element) with every element's
     /// coupling values in its model's order: the mean of the element's node values
     /// (summed in connectivity order, then divided by the node count) for a node field,
     /// the element's value for an element field. The GPU's `coupling_of` repeats these
@@ -767,7 +631,7 @@ impl<D: Dim> Physics<D> for Mechanics {
         // else the previous step's: at most one explicit step old, either way the same
         // on both backends.
         uses.extend(
-            coupling_keys(self.assignments.iter().map(|a| &a.1))
+            CouplingInputs::keys(self.assignments.iter().map(|a| a.1.coupling()))
                 .into_iter()
                 .map(|k| k.read_lagged::<D>()),
         );
@@ -786,7 +650,12 @@ impl<D: Dim> Physics<D> for Mechanics {
         self.material = material;
         self.n_state = self.models.iter().map(|m| m.n_state()).max().unwrap_or(0);
         self.geo = geometry(mesh);
-        self.coupling = self.resolve_coupling(ctx.fields, ne)?;
+        let models: Vec<(&str, &[FieldKey])> = self
+            .models
+            .iter()
+            .map(|m| (m.name(), m.coupling()))
+            .collect();
+        self.coupling = CouplingInputs::resolve(&models, ctx.fields, ne, "constitutive model")?;
         let stress = ctx.fields.id(names::STRESS)?;
         let strain = ctx.fields.id(names::STRAIN)?;
         let extra = ctx.fields.id(if D::D == 2 {
@@ -1043,7 +912,8 @@ impl<D: Dim> Physics<D> for Mechanics {
             )
             .bind("slots", setup.slots(), Access::ReadWrite);
         let kernel = if coupled {
-            self.bind_coupling(setup, kernel)?
+            self.coupling
+                .bind(setup, kernel, "mat_coupling", "material coupling")?
         } else {
             kernel
         };
