@@ -178,25 +178,15 @@ pub(crate) fn setup<D: Dim>(
         Some(b) => b,
         None => setup.upload("no bonds", GpuData::Real(vec![0.0])),
     };
-    // The bonded regions' vertex topology and this step's vertex flags.
+    // The bonded regions: each element's vertices and this step's vertex flags (the
+    // forces kernel binds them; one-entry placeholders without bonds, REGIONS = 0).
     let nv = input.regions.map_or(0, |r| r.n_vertices());
-    let (elem_vertex, vertex_ptr, vertex_faces, vertex_static) = match input.regions {
-        Some(r) => (
-            r.elem_vertex.clone(),
-            r.vertex_ptr.clone(),
-            r.vertex_faces.clone(),
-            r.vertex_static.clone(),
-        ),
-        None => (vec![0], vec![0, 0], vec![0], vec![0]),
-    };
-    let mut vertex_faces = vertex_faces;
-    vertex_faces.resize(vertex_faces.len().max(1), 0);
-    let elem_vertex = setup.upload("element vertices", GpuData::U32(elem_vertex));
-    let vertex_ptr = setup.upload("vertex bond pointers", GpuData::U32(vertex_ptr));
-    let vertex_faces = setup.upload("vertex bond faces", GpuData::U32(vertex_faces));
-    let vertex_static = setup.upload("vertex topology", GpuData::U32(vertex_static));
-    let vertex_flags = setup.upload("vertex flags", GpuData::U32(vec![0; nv.max(1)]));
     let regions = nv > 0;
+    let elem_vertex = setup.upload(
+        "element vertices",
+        GpuData::U32(input.regions.map_or(vec![0], |r| r.elem_vertex.clone())),
+    );
+    let vertex_flags = setup.upload("vertex flags", GpuData::U32(vec![0; nv.max(1)]));
     let overflow = setup.error(move |e| crate::physics::overflow_message(e, capacity));
     let tiny = match setup.precision() {
         Precision::F64 => f64::MIN_POSITIVE,
@@ -336,16 +326,30 @@ pub(crate) fn setup<D: Dim>(
         .bind("vertex_flags", vertex_flags, Access::Read)
         .bind("slots", setup.slots(), Access::ReadWrite),
     ];
-    if regions {
+    if let Some(r) = input.regions.filter(|_| regions) {
         // The vertex flags, after the joints and before the forces.
+        let mut faces = r.vertex_faces.clone();
+        faces.resize(faces.len().max(1), 0);
         let vertices = common(Kernel::new(
             "contact vertices",
             include_str!("shaders/contact_vertices.wgsl"),
             nv,
         ))
-        .bind("vertex_ptr", vertex_ptr, Access::Read)
-        .bind("vertex_faces", vertex_faces, Access::Read)
-        .bind("vertex_static", vertex_static, Access::Read)
+        .bind(
+            "vertex_ptr",
+            setup.upload("vertex bond pointers", GpuData::U32(r.vertex_ptr.clone())),
+            Access::Read,
+        )
+        .bind(
+            "vertex_faces",
+            setup.upload("vertex bond faces", GpuData::U32(faces)),
+            Access::Read,
+        )
+        .bind(
+            "vertex_static",
+            setup.upload("vertex topology", GpuData::U32(r.vertex_static.clone())),
+            Access::Read,
+        )
         .bind("broken", broken, Access::Read)
         .bind("vertex_flags", vertex_flags, Access::ReadWrite);
         let at = kernels.len() - 1;
