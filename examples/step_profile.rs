@@ -15,13 +15,18 @@ use pcdc_compute::{Backend, Simulation};
 use pcdc_mesh::Dim;
 use pcdc_validation::scenes::benchmark::{fdem_block_2d, fdem_cuboid_3d};
 
-fn measure<D: Dim>(mut sim: Simulation<D>, warmup: u64, steps: u64, label: &str) {
+fn measure<D: Dim>(
+    mut sim: Simulation<D>,
+    warmup: u64,
+    steps: u64,
+    label: &str,
+) -> Result<(), Box<dyn std::error::Error>> {
     let n = sim.mesh().n_elements();
     let t0 = Instant::now();
-    sim.run(warmup).expect("warm-up steps");
+    sim.run(warmup)?;
     let warm = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    sim.run(steps).expect("measured steps");
+    sim.run(steps)?;
     let wall = t1.elapsed().as_secs_f64();
     println!(
         "{label}: {n} elements, {steps} steps in {wall:.3} s = {:.3} M element-steps/s ({:.1} ns per element-step); warm-up {warmup} steps {warm:.3} s; state {:.0} B per element",
@@ -29,6 +34,7 @@ fn measure<D: Dim>(mut sim: Simulation<D>, warmup: u64, steps: u64, label: &str)
         wall / (n as f64 * steps as f64) * 1e9,
         sim.state_bytes() as f64 / n as f64
     );
+    Ok(())
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -76,11 +82,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if args.get_one::<String>("dim").map(String::as_str) == Some("3") {
         let cells = args.get_one::<usize>("cells").copied().unwrap_or(16);
         let sim = fdem_cuboid_3d(cells, backend, contact)?;
-        measure(sim, 20, steps, &format!("3D {what}, {threads} thread(s)"));
+        measure(sim, 20, steps, &format!("3D {what}, {threads} thread(s)"))?;
     } else {
         let cells = args.get_one::<usize>("cells").copied().unwrap_or(112);
         let sim = fdem_block_2d(cells, backend, contact)?;
-        measure(sim, 20, steps, &format!("2D {what}, {threads} thread(s)"));
+        measure(sim, 20, steps, &format!("2D {what}, {threads} thread(s)"))?;
     }
     Ok(())
 }

@@ -22,10 +22,9 @@ use std::sync::{Arc, Mutex};
 /// ulps of the coordinates (2.2e-16 m each), whatever its size.
 const TOL: f64 = 1e-15;
 
-/// Soft elements (their forces do not matter) and a cohesive joint model.
-fn sim<D: Dim>(mesh: Mesh<D>) -> Simulation<D> {
-    let soft = LinearElastic::new(1e6, 0.25, 2600.0).unwrap();
-    let czm = IntrinsicCzmParams {
+/// The cohesive joint model of these tests.
+fn czm() -> pcdc_cohesive::IntrinsicCzm {
+    IntrinsicCzmParams {
         friction_deg: 30.0,
         cohesion: 2e6,
         tensile_strength: 1e6,
@@ -36,7 +35,13 @@ fn sim<D: Dim>(mesh: Mesh<D>) -> Simulation<D> {
         penalty_overlap: 3e12,
     }
     .build()
-    .unwrap();
+    .unwrap()
+}
+
+/// Soft elements (their forces do not matter) and a cohesive joint model.
+fn sim<D: Dim>(mesh: Mesh<D>) -> Simulation<D> {
+    let soft = LinearElastic::new(1e6, 0.25, 2600.0).unwrap();
+    let czm = czm();
     Simulation::builder(mesh, Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, soft))
         .physics(CohesiveJoints::new().model(Range::All, czm))
@@ -226,18 +231,7 @@ impl<D: Dim> Physics<D> for OpeningReader {
 fn another_physics_reads_the_opening_through_the_shared_key() {
     let seen = Arc::new(Mutex::new(Vec::new()));
     let soft = LinearElastic::new(1e6, 0.25, 2600.0).unwrap();
-    let czm = IntrinsicCzmParams {
-        friction_deg: 30.0,
-        cohesion: 2e6,
-        tensile_strength: 1e6,
-        gf1: 0.01,
-        gf2: 0.1,
-        penalty_open: 3e11,
-        penalty_shear: 3e11,
-        penalty_overlap: 3e12,
-    }
-    .build()
-    .unwrap();
+    let czm = czm();
     let mut sim = Simulation::builder(two_tets(), Backend::cpu(1).unwrap())
         .physics(Mechanics::new().material(Range::All, soft))
         .physics(CohesiveJoints::new().model(Range::All, czm))
