@@ -379,6 +379,48 @@ mod tests {
         assert!(!p.share_intact_vertex(0, 1));
     }
 
+    /// Meshes that are not a structured pattern (a disc and a plate with a hole, graded,
+    /// 2D; a cylinder, 3D): an element is sealed exactly when none of its corners lies
+    /// on the boundary of the original mesh, and all elements sharing a corner share an
+    /// intact vertex.
+    #[test]
+    fn sealed_iff_away_from_the_boundary_on_graded_meshes() {
+        fn check<D: Dim>(mesh: &Mesh<D>) {
+            let f = mesh.faces();
+            let mut on_boundary = vec![false; mesh.n_nodes()];
+            for (i, &nb) in f.neighbor.iter().enumerate() {
+                if nb == NO_NEIGHBOR {
+                    for &n in mesh.face(i) {
+                        on_boundary[n as usize] = true;
+                    }
+                }
+            }
+            let split = split_nodes(mesh, &Range::All).unwrap();
+            let mut r = regions(&split);
+            r.update(&vec![0.0; split.faces().len()]);
+            let npe = D::NODES_PER_ELEM;
+            let master = |n: u32| split.interfaces().master_of(n) as usize;
+            let mut sealed = 0;
+            for e in 0..split.n_elements() {
+                let touches = split.element(e).iter().any(|&n| on_boundary[master(n)]);
+                assert_eq!(r.sealed(e), !touches, "element {e}");
+                sealed += r.sealed(e) as usize;
+            }
+            assert!(sealed > 0);
+            for e in 0..split.n_elements().min(200) {
+                for g in 0..split.n_elements() {
+                    let share = r.elem_vertex[npe * e..npe * (e + 1)]
+                        .iter()
+                        .any(|v| r.elem_vertex[npe * g..npe * (g + 1)].contains(v));
+                    assert_eq!(r.share_intact_vertex(e, g), share, "{e} {g}");
+                }
+            }
+        }
+        check(&builders::disc([0.0, 0.0], 1.0, 0.15).unwrap());
+        check(&builders::plate_with_hole(1.0, 1.0, 0.2, 0.05, 0.2).unwrap());
+        check(&builders::cylinder(0.5, 1.0, 0.25).unwrap());
+    }
+
     /// Two triangles touching only at a vertex (no glued face) are not connected there.
     #[test]
     fn pinched_triangles_are_not_connected() {
