@@ -4,9 +4,16 @@
 //! Kinematics of a joint: the midplane of its two sides gives the unit normal n (from
 //! side A to side B) and the area; at each Gauss point the gap vector
 //! δ = Σ N_k (x_B,k − x_A,k) splits into the opening o = δ·n and the slip vector
-//! s = δ − o n. The model returns the normal traction σ (positive pulls the sides
-//! together) and the shear magnitude τ (against the slip); side A receives
-//! `w A N_k (σ n + τ s/|s|)` and side B the opposite (exact action-reaction).
+//! s = δ − o n. In 2D this is done once per joint in its frame (n, t): each node pair's
+//! gap is projected on n and t, and at a Gauss point o = Σ N_k g_n,k and the signed slip
+//! s_t = Σ N_k g_t,k give s = s_t t and |s| = |s_t| (no square root). The model returns
+//! the normal traction σ (positive pulls the sides together) and the shear traction
+//! (against the slip); side A receives `A Σ_g w_g N_k (σ n + τ)` and side B the
+//! opposite (exact action-reaction).
+//!
+//! The built-in models ([`IntrinsicCzm`], [`MohrCoulombJoint`]) are called by their
+//! concrete type, so their law inlines into the Gauss-point loop; a plugin model is
+//! called through its trait object.
 //!
 //! Fields ([`crate::fields`]): `joint_state` (model history per Gauss point),
 //! `joint_damage` (largest D per joint, for output), `broken_face` (1 on both faces of a
@@ -28,6 +35,7 @@
 //! repeats this arithmetic in the same order, with each model's WGSL body
 //! ([`crate::WgslJointModel`]) spliced in; it writes the same slots and fields.
 
+use std::any::Any;
 use std::sync::Arc;
 
 use pcdc_compute::coupling::CouplingInputs;
@@ -44,7 +52,8 @@ use rayon::prelude::*;
 use crate::fields::{
     BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
 };
-use crate::{JointInput, JointModel};
+use crate::model::{czm_state, slip_norm};
+use crate::{IntrinsicCzm, JointInput, JointModel, MohrCoulombJoint, Traction};
 
 const JOINT_KERNEL: &str = include_str!("shaders/joints.wgsl");
 const JOINT_LIBRARY: &str = include_str!("shaders/joint_library.wgsl");
@@ -110,6 +119,29 @@ fn gauss_rule(d: usize, points: usize) -> Vec<([f64; 3], f64)> {
     }
 }
 
+/// How the joint loop calls a model: the built-in models by their concrete type, so
+/// that their law inlines into the Gauss-point loop; any other model through its trait
+/// object ([`JointModel::traction_with`], [`JointModel::damage`]).
+#[derive(Clone, Debug)]
+enum Law {
+    Czm(IntrinsicCzm),
+    MohrCoulomb(MohrCoulombJoint),
+    Plugin,
+}
+
+impl Law {
+    /// The law of a model of known type.
+    fn of(model: &dyn Any) -> Law {
+        if let Some(m) = model.downcast_ref::<IntrinsicCzm>() {
+            Law::Czm(m.clone())
+        } else if let Some(m) = model.downcast_ref::<MohrCoulombJoint>() {
+            Law::MohrCoulomb(m.clone())
+        } else {
+            Law::Plugin
+        }
+    }
+}
+
 /// Face-joints with their constitutive models, as a physics: one joint on every
 /// interface of the mesh ([`pcdc_mesh::Mesh::interfaces`], made by
 /// [`pcdc_mesh::split_nodes`]), in the interfaces' order.
@@ -117,11 +149,13 @@ fn gauss_rule(d: usize, points: usize) -> Vec<([f64; 3], f64)> {
 pub struct CohesiveJoints {
     /// The mesh's interfaces (copied at init).
     joints: Interfaces,
-    assignments: Vec<(Range, Arc<dyn JointModel>)>,
+    assignments: Vec<(Range, Arc<dyn JointModel>, Law)>,
     /// Assignments by joint index: (index into `assignments`, joints).
     explicit: Vec<(usize, Vec<u32>)>,
     gauss_3d: usize,
     models: Vec<Arc<dyn JointModel>>,
+    /// How each of `models` is called.
+    laws: Vec<Law>,
     model_of: Vec<u16>,
     h: Vec<f64>,
     rule: Vec<([f64; 3], f64)>,
@@ -147,6 +181,7 @@ impl CohesiveJoints {
             explicit: Vec::new(),
             gauss_3d: 3,
             models: Vec::new(),
+            laws: Vec::new(),
             model_of: Vec::new(),
             h: Vec::new(),
             rule: Vec::new(),
@@ -159,7 +194,8 @@ impl CohesiveJoints {
     /// Assigns a joint model to the joints whose midpoint lies in `range`; later
     /// assignments override earlier ones.
     pub fn model(mut self, range: Range, model: impl JointModel + 'static) -> Self {
-        self.assignments.push((range, Arc::new(model)));
+        let law = Law::of(&model);
+        self.assignments.push((range, Arc::new(model), law));
         self
     }
 
@@ -167,8 +203,9 @@ impl CohesiveJoints {
     /// [`crate::joints_on_fractures`]); later assignments override earlier ones.
     pub fn model_for(mut self, joints: Vec<u32>, model: impl JointModel + 'static) -> Self {
         self.explicit.push((self.assignments.len(), joints));
+        let law = Law::of(&model);
         self.assignments
-            .push((Range::custom(|_| false), Arc::new(model)));
+            .push((Range::custom(|_| false), Arc::new(model), law));
         self
     }
 
@@ -276,9 +313,11 @@ impl CohesiveJoints {
     /// Joint `j`'s opening, sliding and normal into `out` and, unless it is `broken`
     /// (then its slots are zeroed and its damage returned unchanged as `None`), its
     /// forces into `slots` (2·NPF·D values), its state update and its damage; its
-    /// model receives the joint's `coupling` values.
+    /// model, called through `law` (traction and damage after the update), receives the
+    /// joint's `coupling` values.
     #[allow(clippy::too_many_arguments)]
-    fn joint<D: Dim>(
+    #[inline(always)]
+    fn joint<D: Dim, L: FnMut(&JointInput<'_>, &mut [f64]) -> (Traction, f64)>(
         &self,
         j: usize,
         kin: &Kinematics<'_, D>,
@@ -287,6 +326,7 @@ impl CohesiveJoints {
         coupling: &[f64],
         out: JointOut<'_>,
         broken: bool,
+        mut law: L,
     ) -> Option<f64> {
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let nodes = self.joints.joint_nodes(j);
@@ -327,46 +367,72 @@ impl CohesiveJoints {
             slots.fill(0.0);
             return None;
         }
-        // Forces summed in registers, written once (2·NPF·D ≤ 18 values).
-        let mut acc = [0.0f64; 18];
-        let model = &self.models[self.model_of[j] as usize];
+        // Side A's force per unit area, Σ_g w_g N_k (σ n + τ), summed in registers; scaled
+        // by the area and written once, side B's the opposite (exact action-reaction).
+        let mut fa = [0.0f64; 9];
         let ns = self.n_state;
+        let h = self.h[j];
         let mut damage = 0.0f64;
+        // 2D: the kinematics in the joint's frame (n, t = (−n_y, n_x)), once per joint:
+        // each node pair's normal and tangential gap; at a Gauss point the opening and
+        // the signed slip s_t are their interpolants, the slip vector s_t t and |s| = |s_t|.
+        let tg = [-n[1], n[0]];
+        let (mut gn, mut gt) = ([0.0; 2], [0.0; 2]);
+        if d == 2 {
+            for k in 0..2 {
+                gn[k] = gap[2 * k] * n[0] + gap[2 * k + 1] * n[1];
+                gt[k] = gap[2 * k] * tg[0] + gap[2 * k + 1] * tg[1];
+            }
+        }
         for (g, (shape, w)) in self.rule.iter().enumerate() {
-            let mut delta = [0.0; 3];
-            for k in 0..npf {
-                for c in 0..d {
-                    delta[c] += shape[k] * gap[k * d + c];
-                }
-            }
-            let o: f64 = (0..d).map(|c| delta[c] * n[c]).sum();
             let mut s = [0.0; 3];
-            for c in 0..d {
-                s[c] = delta[c] - o * n[c];
-            }
+            let (o, slip_norm) = if d == 2 {
+                let o = shape[0] * gn[0] + shape[1] * gn[1];
+                let st = shape[0] * gt[0] + shape[1] * gt[1];
+                s[0] = st * tg[0];
+                s[1] = st * tg[1];
+                (o, st.abs())
+            } else {
+                // 3D: δ = Σ N_k gap_k, o = δ·n, s = δ − o n.
+                let mut delta = [0.0; 3];
+                for k in 0..npf {
+                    for c in 0..d {
+                        delta[c] += shape[k] * gap[k * d + c];
+                    }
+                }
+                let o: f64 = (0..d).map(|c| delta[c] * n[c]).sum();
+                for c in 0..d {
+                    s[c] = delta[c] - o * n[c];
+                }
+                (o, slip_norm(&s[..d]))
+            };
             let st = &mut state[g * ns..(g + 1) * ns];
             let input = JointInput {
                 opening: o,
                 slip: &s[..d],
-                h: self.h[j],
+                slip_norm,
+                h,
                 coupling,
             };
-            let t = model.traction_with(&input, st);
-            damage = damage.max(model.damage(st));
+            let (t, dmg) = law(&input, st);
+            damage = damage.max(dmg);
             let mut tv = [0.0; 3];
             for c in 0..d {
                 tv[c] = t.normal * n[c] + t.shear[c];
             }
             for k in 0..npf {
-                let f = w * area * shape[k];
+                let wk = w * shape[k];
                 for c in 0..d {
-                    acc[k * d + c] += f * tv[c];
-                    acc[(npf + k) * d + c] -= f * tv[c];
+                    fa[k * d + c] += wk * tv[c];
                 }
             }
         }
-        let n = 2 * npf * d;
-        slots[..n].copy_from_slice(&acc[..n]);
+        let n = npf * d;
+        for i in 0..n {
+            let f = area * fa[i];
+            slots[i] = f;
+            slots[n + i] = -f;
+        }
         Some(damage)
     }
 }
@@ -445,6 +511,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         self.rule = gauss_rule(d, self.gauss_3d);
         self.n_state = self.assigned_state_len();
         self.models = self.assignments.iter().map(|a| a.1.clone()).collect();
+        self.laws = self.assignments.iter().map(|a| a.2.clone()).collect();
         // Model per joint by the midpoint of its side A.
         let mut model_of = vec![u16::MAX; nj];
         let mut mid = vec![0.0; d];
@@ -455,7 +522,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                     mid[c] += mesh.node(n as usize)[c] / npf as f64;
                 }
             }
-            for (i, (range, _)) in self.assignments.iter().enumerate() {
+            for (i, (range, _, _)) in self.assignments.iter().enumerate() {
                 let by_index = self.explicit.iter().find(|(k, _)| *k == i);
                 let hit = match by_index {
                     Some((_, list)) => list.binary_search(&(j as u32)).is_ok(),
@@ -600,15 +667,28 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                         };
                         // A broken joint transfers no force; its kinematics are still
                         // published.
-                        if let Some(dmg) = self.joint::<D>(
-                            j,
-                            kin,
-                            &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d],
-                            &mut st[i * stride..(i + 1) * stride],
-                            cv,
-                            out,
-                            dm[i] >= 1.0,
-                        ) {
+                        let m = self.model_of[j] as usize;
+                        let sl = &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d];
+                        let st = &mut st[i * stride..(i + 1) * stride];
+                        let broken = dm[i] >= 1.0;
+                        let dmg = match &self.laws[m] {
+                            Law::Czm(c) => self.joint(j, kin, sl, st, cv, out, broken, |x, s| {
+                                let t = c.traction_at(x.opening, x.slip, x.slip_norm, x.h, s);
+                                (t, s[czm_state::DAMAGE])
+                            }),
+                            Law::MohrCoulomb(c) => {
+                                self.joint(j, kin, sl, st, cv, out, broken, |x, s| {
+                                    (c.traction_at(x.opening, x.slip, x.h, s), c.damage(s))
+                                })
+                            }
+                            Law::Plugin => {
+                                let model = &self.models[m];
+                                self.joint(j, kin, sl, st, cv, out, broken, |x, s| {
+                                    (model.traction_with(x, s), model.damage(s))
+                                })
+                            }
+                        };
+                        if let Some(dmg) = dmg {
                             dm[i] = dmg;
                         }
                     }
@@ -657,13 +737,13 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let coupled = self.coupling.stride > 0;
         let (params, args) = if coupled {
             (
-                "o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, coupling: JointCoupling, p: u32",
-                "o, slip, h, state, coupling, p",
+                "o: Real, slip: JointVec, slip_norm: Real, h: Real, state: ptr<function, JointState>, coupling: JointCoupling, p: u32",
+                "o, slip, slip_norm, h, state, coupling, p",
             )
         } else {
             (
-                "o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32",
-                "o, slip, h, state, p",
+                "o: Real, slip: JointVec, slip_norm: Real, h: Real, state: ptr<function, JointState>, p: u32",
+                "o, slip, slip_norm, h, state, p",
             )
         };
         let splice = splice_models(

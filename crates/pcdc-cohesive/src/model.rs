@@ -247,6 +247,10 @@ pub struct JointInput<'a> {
     /// Slip vector (m): the tangential gap of side B relative to side A, global
     /// components, length `D`.
     pub slip: &'a [f64],
+    /// |slip| (m), computed once by the joint physics (in 2D the slip's signed length
+    /// along the joint's tangent, so no square root; in 3D √(s·s)); a model reads it
+    /// instead of taking the norm again.
+    pub slip_norm: f64,
     /// Characteristic length h of the joint (m): the mean edge length of its two
     /// elements.
     pub h: f64,
@@ -262,14 +266,22 @@ pub struct JointInput<'a> {
 impl<'a> JointInput<'a> {
     /// The inputs of one evaluation (e.g. to call [`JointModel::traction_with`] in a
     /// test).
+    /// `slip_norm` is √(slip · slip).
     pub fn new(opening: f64, slip: &'a [f64], h: f64, coupling: &'a [f64]) -> Self {
         JointInput {
             opening,
             slip,
+            slip_norm: slip_norm(slip),
             h,
             coupling,
         }
     }
+}
+
+/// √(s · s): the length of a slip vector.
+#[inline]
+pub(crate) fn slip_norm(slip: &[f64]) -> f64 {
+    slip.iter().map(|v| v * v).sum::<f64>().sqrt()
 }
 
 /// A joint model's GPU code, spliced into the joint kernel template (the counterpart of
@@ -278,12 +290,13 @@ impl<'a> JointInput<'a> {
 /// `body` is the body of
 ///
 /// ```text
-/// fn (o: Real, slip: JointVec, h: Real, state: ptr<function, JointState>, p: u32) -> JointTraction
+/// fn (o: Real, slip: JointVec, slip_norm: Real, h: Real, state: ptr<function, JointState>, p: u32) -> JointTraction
 /// ```
 ///
-/// with the arguments of [`JointModel::traction`]: the opening `o` (m), the slip vector
-/// `slip` (m, global components; `JointVec = array<Real, 3>`, components `D..3` are
-/// zero), the characteristic length `h` (m) and the history `(*state)[k]`
+/// with the arguments of [`JointModel::traction_with`]: the opening `o` (m), the slip
+/// vector `slip` (m, global components; `JointVec = array<Real, 3>`, components `D..3`
+/// are zero), its length `slip_norm` (m, [`JointInput::slip_norm`], computed as on the
+/// CPU), the characteristic length `h` (m) and the history `(*state)[k]`
 /// (`JointState = array<Real, NSTATE>`, NSTATE ≥ [`JointModel::n_state`]: the largest
 /// history of the models composed). It returns
 ///
@@ -599,20 +612,20 @@ fn rising(x: f64) -> f64 {
     x * (2.0 - x)
 }
 
-impl JointModel for IntrinsicCzm {
-    fn name(&self) -> &str {
-        "classic-intrinsic-cohesive-interface"
-    }
-
-    fn n_state(&self) -> usize {
-        czm_state::LEN
-    }
-
-    fn traction(&self, o: f64, slip_vec: &[f64], h: f64, state: &mut [f64]) -> Traction {
+impl IntrinsicCzm {
+    /// [`JointModel::traction`], inlined where the joint physics dispatches statically.
+    #[inline(always)]
+    pub(crate) fn traction_at(
+        &self,
+        o: f64,
+        slip_vec: &[f64],
+        slip: f64,
+        h: f64,
+        state: &mut [f64],
+    ) -> Traction {
         use czm_state::*;
         let dv = self.derived;
         let inv_h = 1.0 / h;
-        let slip = slip_vec.iter().map(|v| v * v).sum::<f64>().sqrt();
         let (op, sp) = (dv.op_h * h, dv.sp_h * h);
         // Damage (eq. 68), irreversible. Before the peak in both modes nothing is
         // evaluated beyond comparisons: an undamaged joint pays no exp/pow.
@@ -676,6 +689,24 @@ impl JointModel for IntrinsicCzm {
         }
         Traction { normal, shear: sv }
     }
+}
+
+impl JointModel for IntrinsicCzm {
+    fn name(&self) -> &str {
+        "classic-intrinsic-cohesive-interface"
+    }
+
+    fn n_state(&self) -> usize {
+        czm_state::LEN
+    }
+
+    fn traction(&self, o: f64, slip_vec: &[f64], h: f64, state: &mut [f64]) -> Traction {
+        self.traction_at(o, slip_vec, slip_norm(slip_vec), h, state)
+    }
+
+    fn traction_with(&self, input: &JointInput<'_>, state: &mut [f64]) -> Traction {
+        self.traction_at(input.opening, input.slip, input.slip_norm, input.h, state)
+    }
 
     fn max_stiffness(&self, h: f64) -> f64 {
         // Initial slopes: 2 T_s / o_p = P_open / h, 2 T_s / o_overlap = P_overlap / h.
@@ -732,6 +763,8 @@ pub struct MohrCoulombJoint {
     cohesion: f64,
     penalty_normal: f64,
     penalty_shear: f64,
+    /// tan φ, cached: no trigonometry per evaluation.
+    tan_phi: f64,
 }
 
 /// Parameters of a [`MohrCoulombJoint`] (a pre-existing fracture, manual keyword
@@ -822,6 +855,7 @@ impl MohrCoulombJoint {
             cohesion,
             penalty_normal,
             penalty_shear,
+            tan_phi: friction_deg.to_radians().tan(),
         })
     }
 
@@ -856,16 +890,10 @@ impl MohrCoulombJoint {
     }
 }
 
-impl JointModel for MohrCoulombJoint {
-    fn name(&self) -> &str {
-        "joint-mohr-coulomb"
-    }
-
-    fn n_state(&self) -> usize {
-        3
-    }
-
-    fn traction(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction {
+impl MohrCoulombJoint {
+    /// [`JointModel::traction`], inlined where the joint physics dispatches statically.
+    #[inline(always)]
+    pub(crate) fn traction_at(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction {
         let mut t = Traction::default();
         if o >= 0.0 {
             // Open: no traction; the elastic slip restarts from the current slip.
@@ -875,7 +903,7 @@ impl JointModel for MohrCoulombJoint {
             return t;
         }
         t.normal = self.penalty_normal * o / h;
-        let strength = (self.cohesion - t.normal * self.friction_deg.to_radians().tan()).max(0.0);
+        let strength = (self.cohesion - t.normal * self.tan_phi).max(0.0);
         let kt = self.penalty_shear / h;
         let mut trial = [0.0; 3];
         for (k, v) in slip.iter().enumerate() {
@@ -892,6 +920,20 @@ impl JointModel for MohrCoulombJoint {
         }
         t.shear = trial;
         t
+    }
+}
+
+impl JointModel for MohrCoulombJoint {
+    fn name(&self) -> &str {
+        "joint-mohr-coulomb"
+    }
+
+    fn n_state(&self) -> usize {
+        3
+    }
+
+    fn traction(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction {
+        self.traction_at(o, slip, h, state)
     }
 
     fn max_stiffness(&self, h: f64) -> f64 {
@@ -911,7 +953,7 @@ impl JointModel for MohrCoulombJoint {
                 self.penalty_normal,
                 self.penalty_shear,
                 self.cohesion,
-                self.friction_deg.to_radians().tan(),
+                self.tan_phi,
             ],
         })
     }

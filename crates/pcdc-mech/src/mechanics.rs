@@ -25,7 +25,7 @@ use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
 use crate::kinematics::{dm_inv_2d, polar_2d_h, polar_3d};
-use crate::model::{double_dot, ConstitutiveModel, ModelInput, Sym6};
+use crate::model::{double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6};
 use crate::MechError;
 
 const CHUNK: usize = 256;
@@ -71,14 +71,34 @@ pub struct SurfaceProperties {
 /// Element mechanics: materials assigned by range; later assignments override earlier.
 #[derive(Debug, Default)]
 pub struct Mechanics {
-    assignments: Vec<(Range, Arc<dyn ConstitutiveModel>)>,
+    assignments: Vec<Assignment>,
     initial_stress: Vec<(Range, Sym6)>,
     models: Vec<Arc<dyn ConstitutiveModel>>,
+    /// Per model (as `models`): the constants the element loop reads.
+    consts: Vec<ModelConsts>,
     material: Vec<u16>,
     n_state: usize,
     geo: ElementGeometry,
     ids: Option<Ids>,
     coupling: CouplingInputs,
+}
+
+/// A material assignment: the range, the model, and λ and 2μ (Pa) when the model is
+/// the built-in [`LinearElastic`].
+type Assignment = (Range, Arc<dyn ConstitutiveModel>, Option<(f64, f64)>);
+
+/// Constants of one model that the element loop reads every step, cached at init: the
+/// built-in linear elastic law is applied inline (no call through the trait object)
+/// and the viscous coefficient needs no square root per element.
+#[derive(Clone, Copy, Debug)]
+struct ModelConsts {
+    /// λ and 2μ (Pa) when the model is [`LinearElastic`], whose update
+    /// σ += λ tr(Δε) I + 2μ Δε is then evaluated in the element loop.
+    elastic: Option<(f64, f64)>,
+    /// 2 D_f (the viscous damping factor doubled, eq. 18-19).
+    damp2: f64,
+    /// √(ρ E) (Pa·s/m): `D_f C = 2 D_f L √(ρE)` with the element's mean edge L.
+    sqrt_rho_e: f64,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -101,13 +121,16 @@ impl Mechanics {
 
     /// Assigns a constitutive model to the elements in `range` (by centroid).
     pub fn material(mut self, range: Range, model: impl ConstitutiveModel + 'static) -> Self {
-        self.assignments.push((range, Arc::new(model)));
+        let elastic = (&model as &dyn std::any::Any)
+            .downcast_ref::<LinearElastic>()
+            .map(|m| (m.lambda(), 2.0 * m.shear()));
+        self.assignments.push((range, Arc::new(model), elastic));
         self
     }
 
     /// Assigns a shared model (e.g. a user plugin behind an `Arc`).
     pub fn material_arc(mut self, range: Range, model: Arc<dyn ConstitutiveModel>) -> Self {
-        self.assignments.push((range, model));
+        self.assignments.push((range, model, None));
         self
     }
 
@@ -138,7 +161,7 @@ impl Mechanics {
         }
         let mut material = vec![u16::MAX; ne];
         let mut models = Vec::new();
-        for (i, (range, model)) in self.assignments.iter().enumerate() {
+        for (i, (range, model, _)) in self.assignments.iter().enumerate() {
             let sel = mesh.select_elements(range)?;
             if sel.is_empty() {
                 return Err(MechError::EmptyRange {
@@ -379,7 +402,7 @@ struct StepInputs<'a> {
 impl Mechanics {
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn element_2d(
+    fn element_2d<U: FnOnce(&ModelInput<'_>, &mut Sym6, &mut [f64])>(
         &self,
         e: usize,
         inp: &StepInputs<'_>,
@@ -389,6 +412,8 @@ impl Mechanics {
         szz: &mut f64,
         state: &mut [f64],
         coupling: &[f64],
+        visc: Option<f64>,
+        update: U,
     ) {
         let c = &inp.conn[3 * e..3 * e + 3];
         let (n0, n1, n2) = (c[0] as usize * 2, c[1] as usize * 2, c[2] as usize * 2);
@@ -426,17 +451,16 @@ impl Mechanics {
         ];
         strain.copy_from_slice(&[eps[0], eps[1], eps[3]]);
         let mut sig: Sym6 = [stress[0], stress[1], *szz, stress[2], 0.0, 0.0];
-        let model = self.model_of(e);
         let input = ModelInput {
             strain: &eps,
             dstrain: &de,
             coupling,
         };
-        model.update_with(&input, &mut sig, state);
+        update(&input, &mut sig, state);
         stress.copy_from_slice(&[sig[0], sig[1], sig[3]]);
         *szz = sig[2];
         let (mut sxx, mut syy, mut sxy) = (sig[0], sig[1], sig[3]);
-        if inp.damping && model.damp_factor() > 0.0 {
+        if let Some(cv) = visc {
             let vv = |n: usize, k: usize| inp.v[n + k];
             let (vx0, vy0) = (vv(n0, 0), vv(n0, 1));
             let dv = [
@@ -456,7 +480,6 @@ impl Mechanics {
             let r10 = -si * fd[0] + co * fd[2];
             let r11 = -si * fd[1] + co * fd[3];
             // eq. 17-19: σ_v = D_f C ε̇ with C = 2 L √(ρE)
-            let cv = self.viscous_coefficient(e);
             sxx += cv * r00;
             syy += cv * r11;
             sxy += cv * 0.5 * (r01 + r10);
@@ -489,7 +512,7 @@ impl Mechanics {
 
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn element_3d(
+    fn element_3d<U: FnOnce(&ModelInput<'_>, &mut Sym6, &mut [f64])>(
         &self,
         e: usize,
         inp: &StepInputs<'_>,
@@ -499,6 +522,8 @@ impl Mechanics {
         rot: &mut [f64],
         state: &mut [f64],
         coupling: &[f64],
+        visc: Option<f64>,
+        update: U,
     ) {
         let c = &inp.conn[4 * e..4 * e + 4];
         let n: [usize; 4] = [
@@ -541,15 +566,14 @@ impl Mechanics {
         let mut sig: Sym6 = [
             stress[0], stress[1], stress[2], stress[3], stress[4], stress[5],
         ];
-        let model = self.model_of(e);
         let input = ModelInput {
             strain: &eps,
             dstrain: &de,
             coupling,
         };
-        model.update_with(&input, &mut sig, state);
+        update(&input, &mut sig, state);
         stress.copy_from_slice(&sig);
-        if inp.damping && model.damp_factor() > 0.0 {
+        if let Some(cv) = visc {
             let mut dv = [0.0; 9];
             for i in 0..3 {
                 let o = inp.v[n[0] + i];
@@ -559,7 +583,6 @@ impl Mechanics {
             }
             let fd = crate::kinematics::mul3(&dv, &mm);
             let rd = crate::kinematics::mul3_tn(&r, &fd);
-            let cv = self.viscous_coefficient(e);
             sig[0] += cv * rd[0];
             sig[1] += cv * rd[4];
             sig[2] += cv * rd[8];
@@ -646,6 +669,15 @@ impl<D: Dim> Physics<D> for Mechanics {
         let mesh = ctx.mesh;
         let ne = mesh.n_elements();
         let (material, models) = self.resolve(mesh)?;
+        self.consts = models
+            .iter()
+            .zip(&self.assignments)
+            .map(|(m, a)| ModelConsts {
+                elastic: a.2,
+                damp2: m.damp_factor() * 2.0,
+                sqrt_rho_e: (m.density() * m.young()).sqrt(),
+            })
+            .collect();
         self.models = models;
         self.material = material;
         self.n_state = self.models.iter().map(|m| m.n_state()).max().unwrap_or(0);
@@ -788,11 +820,44 @@ impl<D: Dim> Physics<D> for Mechanics {
                             let n = self.coupling.len_of_model[self.material[e] as usize];
                             &cref[e * cstride..e * cstride + n]
                         };
-                        if d == 2 {
-                            self.element_2d(e, &inp, sl, st, ep, &mut ex[i], ms, cv);
-                        } else {
-                            let ex = &mut ex[i * 9..i * 9 + 9];
-                            self.element_3d(e, &inp, sl, st, ep, ex, ms, cv);
+                        let mi = self.material[e] as usize;
+                        let k = self.consts[mi];
+                        // The viscous coefficient D_f C = 2 D_f L √(ρE) (eq. 17-19), in
+                        // the order of `viscous_coefficient`.
+                        let visc = (inp.damping && k.damp2 > 0.0)
+                            .then(|| k.damp2 * self.geo.mean_edge[e] * k.sqrt_rho_e);
+                        let model = &*self.models[mi];
+                        // The built-in elastic law inline, any other through its trait.
+                        macro_rules! element {
+                            ($update:expr) => {
+                                if d == 2 {
+                                    self.element_2d(
+                                        e, &inp, sl, st, ep, &mut ex[i], ms, cv, visc, $update,
+                                    );
+                                } else {
+                                    let ex = &mut ex[i * 9..i * 9 + 9];
+                                    self.element_3d(e, &inp, sl, st, ep, ex, ms, cv, visc, $update);
+                                }
+                            };
+                        }
+                        match k.elastic {
+                            Some((l, m2)) => {
+                                element!(|x: &ModelInput<'_>, sig: &mut Sym6, _: &mut [f64]| {
+                                    let de = x.dstrain;
+                                    let tr = de[0] + de[1] + de[2];
+                                    for c in 0..3 {
+                                        sig[c] += l * tr + m2 * de[c];
+                                    }
+                                    for c in 3..6 {
+                                        sig[c] += m2 * de[c];
+                                    }
+                                })
+                            }
+                            None => {
+                                element!(|x: &ModelInput<'_>, sig: &mut Sym6, st: &mut [f64]| {
+                                    model.update_with(x, sig, st)
+                                })
+                            }
                         }
                     }
                 });

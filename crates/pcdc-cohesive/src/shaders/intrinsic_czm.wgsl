@@ -12,11 +12,7 @@ let ts = param(p, 5u);
 let coh = param(p, 6u);
 let p_overlap = param(p, 7u);
 let inv_h = 1.0 / h;
-var slip2 = Real(0.0);
-for (var k = 0u; k < D; k = k + 1u) {
-    slip2 = slip2 + slip[k] * slip[k];
-}
-let s = sqrt(slip2);
+let s = slip_norm;
 let op = op_h * h;
 let sp = sp_h * h;
 // Damage (eq. 68), irreversible.
