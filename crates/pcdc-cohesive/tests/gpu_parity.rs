@@ -25,9 +25,12 @@
 //! drift. In f32 the difference is measured and printed. Without a GPU adapter the tests
 //! skip (and fail with PCDC_REQUIRE_GPU=1).
 
+use std::sync::Arc;
+
 use pcdc_cohesive::{
-    joints_on_fractures, CohesiveJoints, Fracture, IntrinsicCzmParams, MohrCoulombJointParams,
-    BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
+    joints_on_fractures, CohesiveJoints, Fracture, IntrinsicCzmParams, JointInput, JointModel,
+    MohrCoulombJointParams, Traction, WgslJointModel, BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL,
+    JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
 };
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{Backend, Precision, Simulation};
@@ -60,6 +63,44 @@ struct Scene {
     steps: u64,
     /// Relative perturbation of the initial velocities (0 for the compared runs).
     perturb: f64,
+    /// Hide the built-in models' types ([`Opaque`], `Mechanics::material_arc`), so the
+    /// physics call them through their trait objects instead of inline.
+    opaque: bool,
+}
+
+/// A joint model that hides its type: the joint physics calls it through its trait
+/// object (the path of a user's plugin), not inline as it calls the built-in models.
+#[derive(Debug)]
+struct Opaque<M>(M);
+
+impl<M: JointModel> JointModel for Opaque<M> {
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+    fn n_state(&self) -> usize {
+        self.0.n_state()
+    }
+    fn init_state(&self, state: &mut [f64]) {
+        self.0.init_state(state)
+    }
+    fn traction(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction {
+        self.0.traction(o, slip, h, state)
+    }
+    fn traction_with(&self, input: &JointInput<'_>, state: &mut [f64]) -> Traction {
+        self.0.traction_with(input, state)
+    }
+    fn max_stiffness(&self, h: f64) -> f64 {
+        self.0.max_stiffness(h)
+    }
+    fn is_broken(&self, state: &[f64]) -> bool {
+        self.0.is_broken(state)
+    }
+    fn damage(&self, state: &[f64]) -> f64 {
+        self.0.damage(state)
+    }
+    fn wgsl(&self) -> Option<WgslJointModel> {
+        self.0.wgsl()
+    }
 }
 
 /// Stretch with some shear, 400 steps: the weak band softens and breaks.
@@ -71,6 +112,7 @@ fn pull() -> Scene {
         gauss_3d: 3,
         steps: 400,
         perturb: 0.0,
+        opaque: false,
     }
 }
 
@@ -84,6 +126,7 @@ fn slide(fracture: Fracture) -> Scene {
         gauss_3d: 3,
         steps: 200,
         perturb: 0.0,
+        opaque: false,
     }
 }
 
@@ -148,31 +191,44 @@ fn run<D: Dim>(mesh: &Mesh<D>, backend: Backend, s: &Scene) -> Outcome {
     }
     .build()
     .unwrap();
-    let mut joints = CohesiveJoints::new()
-        .model(Range::All, strong)
-        .model(band, weak)
-        .gauss_points_3d(s.gauss_3d);
+    let mut joints = if s.opaque {
+        CohesiveJoints::new()
+            .model(Range::All, Opaque(strong))
+            .model(band, Opaque(weak))
+    } else {
+        CohesiveJoints::new()
+            .model(Range::All, strong)
+            .model(band, weak)
+    }
+    .gauss_points_3d(s.gauss_3d);
     if let Some(f) = s.fracture.clone() {
         let on = joints_on_fractures(&split, &[f]).unwrap();
         assert!(!on.is_empty());
-        joints = joints.model_for(
-            on,
-            MohrCoulombJointParams {
-                friction_deg: 30.0,
-                cohesion: 0.0,
-                penalty_normal: 10.0 * E,
-                penalty_shear: 10.0 * E,
-            }
-            .build()
-            .unwrap(),
-        );
+        let fracture = MohrCoulombJointParams {
+            friction_deg: 30.0,
+            cohesion: 0.0,
+            penalty_normal: 10.0 * E,
+            penalty_shear: 10.0 * E,
+        }
+        .build()
+        .unwrap();
+        joints = if s.opaque {
+            joints.model_for(on, Opaque(fracture))
+        } else {
+            joints.model_for(on, fracture)
+        };
     }
     let rock = LinearElastic::new(E, 0.25, 2600.0)
         .unwrap()
         .with_damping(0.1)
         .unwrap();
+    let mechanics = if s.opaque {
+        Mechanics::new().material_arc(Range::All, Arc::new(rock))
+    } else {
+        Mechanics::new().material(Range::All, rock)
+    };
     let mut sim = Simulation::builder(split.clone(), backend)
-        .physics(Mechanics::new().material(Range::All, rock))
+        .physics(mechanics)
         .physics(joints)
         .build()
         .unwrap();
@@ -457,4 +513,36 @@ fn joint_forces_agree_to_rounding() {
         );
         assert!(dk_normal <= 1e-14, "normal differs by {dk_normal:e}");
     }
+}
+
+/// The built-in models called inline (by concrete type) and through their trait objects
+/// (the plugin path) give the same bits: the static dispatch changes nothing but the
+/// speed, in 2D and 3D, for the cohesive law, the fracture law and the elastic law.
+fn inline_matches_trait_objects<D: Dim>(mesh: Mesh<D>, fracture: Fracture) {
+    for scene in [pull(), slide(fracture)] {
+        let inline = run(&mesh, Backend::cpu(1).unwrap(), &scene);
+        let opaque = run(
+            &mesh,
+            Backend::cpu(1).unwrap(),
+            &Scene {
+                opaque: true,
+                ..scene.clone()
+            },
+        );
+        assert!(max_abs(&inline.u) > 0.0 && max_abs(&inline.state) > 0.0);
+        assert_eq!(inline.u, opaque.u);
+        assert_eq!(inline.state, opaque.state);
+        assert_eq!(inline.damage, opaque.damage);
+        assert_eq!(inline.broken, opaque.broken);
+    }
+}
+
+#[test]
+fn inline_models_match_trait_objects_2d() {
+    inline_matches_trait_objects(bar_2d(), fracture_2d());
+}
+
+#[test]
+fn inline_models_match_trait_objects_3d() {
+    inline_matches_trait_objects(bar_3d(), fracture_3d());
 }
