@@ -52,8 +52,8 @@ use rayon::prelude::*;
 use crate::fields::{
     BROKEN_FACE, JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING, JOINT_STATE,
 };
-use crate::model::{czm_state, slip_norm};
-use crate::{IntrinsicCzm, JointInput, JointModel, MohrCoulombJoint, Traction};
+use crate::model::slip_norm;
+use crate::{IntrinsicCzm, JointInput, JointModel, MohrCoulombJoint};
 
 const JOINT_KERNEL: &str = include_str!("shaders/joints.wgsl");
 const JOINT_LIBRARY: &str = include_str!("shaders/joint_library.wgsl");
@@ -119,26 +119,44 @@ fn gauss_rule(d: usize, points: usize) -> Vec<([f64; 3], f64)> {
     }
 }
 
-/// How the joint loop calls a model: the built-in models by their concrete type, so
-/// that their law inlines into the Gauss-point loop; any other model through its trait
-/// object ([`JointModel::traction_with`], [`JointModel::damage`]).
-#[derive(Clone, Debug)]
-enum Law {
+/// A joint model as the physics holds it: a built-in model by its concrete type, so that
+/// its law inlines into the Gauss-point loop (`CohesiveJoints::joint` is generic over
+/// the model); any other model behind its trait object, called through the vtable.
+#[derive(Clone)]
+enum Model {
     Czm(IntrinsicCzm),
     MohrCoulomb(MohrCoulombJoint),
-    Plugin,
+    Plugin(Arc<dyn JointModel>),
 }
 
-impl Law {
-    /// The law of a model of known type.
-    fn of(model: &dyn Any) -> Law {
-        if let Some(m) = model.downcast_ref::<IntrinsicCzm>() {
-            Law::Czm(m.clone())
-        } else if let Some(m) = model.downcast_ref::<MohrCoulombJoint>() {
-            Law::MohrCoulomb(m.clone())
+impl Model {
+    /// The built-in models recognised by type; any other is a plugin.
+    fn new(model: impl JointModel + 'static) -> Model {
+        let any: &dyn Any = &model;
+        if let Some(m) = any.downcast_ref::<IntrinsicCzm>() {
+            Model::Czm(m.clone())
+        } else if let Some(m) = any.downcast_ref::<MohrCoulombJoint>() {
+            Model::MohrCoulomb(m.clone())
         } else {
-            Law::Plugin
+            Model::Plugin(Arc::new(model))
         }
+    }
+
+    /// The model as a trait object (for everything outside the joint loop).
+    fn get(&self) -> &dyn JointModel {
+        match self {
+            Model::Czm(m) => m,
+            Model::MohrCoulomb(m) => m,
+            Model::Plugin(m) => &**m,
+        }
+    }
+}
+
+/// The model's own `Debug` (it enters the physics' fingerprint, which must not depend on
+/// how the model is held).
+impl std::fmt::Debug for Model {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Debug::fmt(self.get(), f)
     }
 }
 
@@ -149,13 +167,11 @@ impl Law {
 pub struct CohesiveJoints {
     /// The mesh's interfaces (copied at init).
     joints: Interfaces,
-    assignments: Vec<(Range, Arc<dyn JointModel>, Law)>,
+    assignments: Vec<(Range, Model)>,
     /// Assignments by joint index: (index into `assignments`, joints).
     explicit: Vec<(usize, Vec<u32>)>,
     gauss_3d: usize,
-    models: Vec<Arc<dyn JointModel>>,
-    /// How each of `models` is called.
-    laws: Vec<Law>,
+    models: Vec<Model>,
     model_of: Vec<u16>,
     h: Vec<f64>,
     rule: Vec<([f64; 3], f64)>,
@@ -181,7 +197,6 @@ impl CohesiveJoints {
             explicit: Vec::new(),
             gauss_3d: 3,
             models: Vec::new(),
-            laws: Vec::new(),
             model_of: Vec::new(),
             h: Vec::new(),
             rule: Vec::new(),
@@ -194,8 +209,7 @@ impl CohesiveJoints {
     /// Assigns a joint model to the joints whose midpoint lies in `range`; later
     /// assignments override earlier ones.
     pub fn model(mut self, range: Range, model: impl JointModel + 'static) -> Self {
-        let law = Law::of(&model);
-        self.assignments.push((range, Arc::new(model), law));
+        self.assignments.push((range, Model::new(model)));
         self
     }
 
@@ -203,9 +217,8 @@ impl CohesiveJoints {
     /// [`crate::joints_on_fractures`]); later assignments override earlier ones.
     pub fn model_for(mut self, joints: Vec<u32>, model: impl JointModel + 'static) -> Self {
         self.explicit.push((self.assignments.len(), joints));
-        let law = Law::of(&model);
         self.assignments
-            .push((Range::custom(|_| false), Arc::new(model), law));
+            .push((Range::custom(|_| false), Model::new(model)));
         self
     }
 
@@ -219,7 +232,7 @@ impl CohesiveJoints {
     fn assigned_state_len(&self) -> usize {
         self.assignments
             .iter()
-            .map(|a| a.1.n_state())
+            .map(|a| a.1.get().n_state())
             .max()
             .unwrap_or(1)
             .max(1)
@@ -313,11 +326,11 @@ impl CohesiveJoints {
     /// Joint `j`'s opening, sliding and normal into `out` and, unless it is `broken`
     /// (then its slots are zeroed and its damage returned unchanged as `None`), its
     /// forces into `slots` (2·NPF·D values), its state update and its damage; its
-    /// model, called through `law` (traction and damage after the update), receives the
+    /// `model` (a concrete built-in type, inlined, or a trait object) receives the
     /// joint's `coupling` values.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn joint<D: Dim, L: FnMut(&JointInput<'_>, &mut [f64]) -> (Traction, f64)>(
+    fn joint<D: Dim, M: JointModel + ?Sized>(
         &self,
         j: usize,
         kin: &Kinematics<'_, D>,
@@ -326,7 +339,7 @@ impl CohesiveJoints {
         coupling: &[f64],
         out: JointOut<'_>,
         broken: bool,
-        mut law: L,
+        model: &M,
     ) -> Option<f64> {
         let (d, npf) = (D::D, D::NODES_PER_FACE);
         let nodes = self.joints.joint_nodes(j);
@@ -414,8 +427,8 @@ impl CohesiveJoints {
                 h,
                 coupling,
             };
-            let (t, dmg) = law(&input, st);
-            damage = damage.max(dmg);
+            let t = model.traction_with(&input, st);
+            damage = damage.max(model.damage(st));
             let mut tv = [0.0; 3];
             for c in 0..d {
                 tv[c] = t.normal * n[c] + t.shear[c];
@@ -475,7 +488,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         // when the joints' forces stage runs: at most one explicit step old, the same on
         // both backends.
         uses.extend(
-            CouplingInputs::keys(self.assignments.iter().map(|a| a.1.coupling()))
+            CouplingInputs::keys(self.assignments.iter().map(|a| a.1.get().coupling()))
                 .into_iter()
                 .map(|k| k.read_lagged::<D>()),
         );
@@ -511,7 +524,6 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         self.rule = gauss_rule(d, self.gauss_3d);
         self.n_state = self.assigned_state_len();
         self.models = self.assignments.iter().map(|a| a.1.clone()).collect();
-        self.laws = self.assignments.iter().map(|a| a.2.clone()).collect();
         // Model per joint by the midpoint of its side A.
         let mut model_of = vec![u16::MAX; nj];
         let mut mid = vec![0.0; d];
@@ -522,7 +534,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                     mid[c] += mesh.node(n as usize)[c] / npf as f64;
                 }
             }
-            for (i, (range, _, _)) in self.assignments.iter().enumerate() {
+            for (i, (range, _)) in self.assignments.iter().enumerate() {
                 let by_index = self.explicit.iter().find(|(k, _)| *k == i);
                 let hit = match by_index {
                     Some((_, list)) => list.binary_search(&(j as u32)).is_ok(),
@@ -574,7 +586,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let st = ctx.fields.get_mut(state);
         let ns = self.n_state;
         for j in 0..nj {
-            let m = &self.models[self.model_of[j] as usize];
+            let m = self.models[self.model_of[j] as usize].get();
             for g in 0..self.rule.len() {
                 m.init_state(&mut st[j * stride + g * ns..j * stride + g * ns + m.n_state()]);
             }
@@ -583,7 +595,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         let models: Vec<(&str, &[FieldKey])> = self
             .models
             .iter()
-            .map(|m| (m.name(), m.coupling()))
+            .map(|m| (m.get().name(), m.get().coupling()))
             .collect();
         self.coupling =
             CouplingInputs::resolve(&models, ctx.fields, self.joints.len(), "joint model")?;
@@ -602,8 +614,11 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                 mid[k * D::D..(k + 1) * D::D].copy_from_slice(kin.mesh.node(nodes[k] as usize));
             }
             let area = D::face_measure_normal(&mid[..npf * D::D], &mut n[..D::D]);
-            let k_node =
-                self.models[self.model_of[j] as usize].max_stiffness(self.h[j]) * area / npf as f64;
+            let k_node = self.models[self.model_of[j] as usize]
+                .get()
+                .max_stiffness(self.h[j])
+                * area
+                / npf as f64;
             for k in 0..npf {
                 let (ma, mb) = (
                     kin.mass[nodes[k] as usize],
@@ -667,26 +682,13 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                         };
                         // A broken joint transfers no force; its kinematics are still
                         // published.
-                        let m = self.model_of[j] as usize;
                         let sl = &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d];
                         let st = &mut st[i * stride..(i + 1) * stride];
                         let broken = dm[i] >= 1.0;
-                        let dmg = match &self.laws[m] {
-                            Law::Czm(c) => self.joint(j, kin, sl, st, cv, out, broken, |x, s| {
-                                let t = c.traction_at(x.opening, x.slip, x.slip_norm, x.h, s);
-                                (t, s[czm_state::DAMAGE])
-                            }),
-                            Law::MohrCoulomb(c) => {
-                                self.joint(j, kin, sl, st, cv, out, broken, |x, s| {
-                                    (c.traction_at(x.opening, x.slip, x.h, s), c.damage(s))
-                                })
-                            }
-                            Law::Plugin => {
-                                let model = &self.models[m];
-                                self.joint(j, kin, sl, st, cv, out, broken, |x, s| {
-                                    (model.traction_with(x, s), model.damage(s))
-                                })
-                            }
+                        let dmg = match &self.models[self.model_of[j] as usize] {
+                            Model::Czm(m) => self.joint(j, kin, sl, st, cv, out, broken, m),
+                            Model::MohrCoulomb(m) => self.joint(j, kin, sl, st, cv, out, broken, m),
+                            Model::Plugin(m) => self.joint(j, kin, sl, st, cv, out, broken, &**m),
                         };
                         if let Some(dmg) = dmg {
                             dm[i] = dmg;
@@ -724,7 +726,7 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         }
         // One WGSL function per distinct model key; parameters per model.
         let mut bodies = Vec::with_capacity(self.models.len());
-        for m in &self.models {
+        for m in self.models.iter().map(Model::get) {
             bodies.push(m.wgsl().ok_or_else(|| ComputeError::NoGpuKernel {
                 physics: "cohesive joints".into(),
                 reason: format!(

@@ -613,9 +613,10 @@ fn rising(x: f64) -> f64 {
 }
 
 impl IntrinsicCzm {
-    /// [`JointModel::traction`], inlined where the joint physics dispatches statically.
+    /// [`JointModel::traction`] with the slip's length `slip` given (the physics
+    /// computes it, [`JointInput::slip_norm`]).
     #[inline(always)]
-    pub(crate) fn traction_at(
+    fn traction_at(
         &self,
         o: f64,
         slip_vec: &[f64],
@@ -704,6 +705,8 @@ impl JointModel for IntrinsicCzm {
         self.traction_at(o, slip_vec, slip_norm(slip_vec), h, state)
     }
 
+    // Inlined into the joint loop, which calls the built-in models by type.
+    #[inline(always)]
     fn traction_with(&self, input: &JointInput<'_>, state: &mut [f64]) -> Traction {
         self.traction_at(input.opening, input.slip, input.slip_norm, input.h, state)
     }
@@ -721,6 +724,7 @@ impl JointModel for IntrinsicCzm {
         state[czm_state::DAMAGE] >= 1.0
     }
 
+    #[inline(always)]
     fn damage(&self, state: &[f64]) -> f64 {
         state[czm_state::DAMAGE]
     }
@@ -890,10 +894,18 @@ impl MohrCoulombJoint {
     }
 }
 
-impl MohrCoulombJoint {
-    /// [`JointModel::traction`], inlined where the joint physics dispatches statically.
+impl JointModel for MohrCoulombJoint {
+    fn name(&self) -> &str {
+        "joint-mohr-coulomb"
+    }
+
+    fn n_state(&self) -> usize {
+        3
+    }
+
+    // Inlined into the joint loop, which calls the built-in models by type.
     #[inline(always)]
-    pub(crate) fn traction_at(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction {
+    fn traction(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction {
         let mut t = Traction::default();
         if o >= 0.0 {
             // Open: no traction; the elastic slip restarts from the current slip.
@@ -920,20 +932,6 @@ impl MohrCoulombJoint {
         }
         t.shear = trial;
         t
-    }
-}
-
-impl JointModel for MohrCoulombJoint {
-    fn name(&self) -> &str {
-        "joint-mohr-coulomb"
-    }
-
-    fn n_state(&self) -> usize {
-        3
-    }
-
-    fn traction(&self, o: f64, slip: &[f64], h: f64, state: &mut [f64]) -> Traction {
-        self.traction_at(o, slip, h, state)
     }
 
     fn max_stiffness(&self, h: f64) -> f64 {
