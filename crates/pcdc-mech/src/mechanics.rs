@@ -25,7 +25,7 @@ use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
 use crate::kinematics::{dm_inv_2d, polar_2d_h, polar_3d};
-use crate::model::{double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6};
+use crate::model::{add_hooke, double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6};
 use crate::MechError;
 
 const CHUNK: usize = 256;
@@ -301,10 +301,11 @@ impl Mechanics {
         &*self.models[self.material[e] as usize]
     }
 
-    /// Viscous coefficient `D_f C` of element `e` with `C = 2 L √(ρE)` (eq. 18-19), Pa·s.
+    /// Viscous coefficient `D_f C` of element `e` with `C = 2 L √(ρE)` (eq. 18-19), Pa·s,
+    /// from its model's cached constants.
     fn viscous_coefficient(&self, e: usize) -> f64 {
-        let m = self.model_of(e);
-        m.damp_factor() * 2.0 * self.geo.mean_edge[e] * (m.density() * m.young()).sqrt()
+        let k = &self.consts[self.material[e] as usize];
+        k.damp2 * self.geo.mean_edge[e] * k.sqrt_rho_e
     }
 
     fn element_dt(&self, e: usize, damped: bool) -> f64 {
@@ -822,10 +823,8 @@ impl<D: Dim> Physics<D> for Mechanics {
                         };
                         let mi = self.material[e] as usize;
                         let k = self.consts[mi];
-                        // The viscous coefficient D_f C = 2 D_f L √(ρE) (eq. 17-19), in
-                        // the order of `viscous_coefficient`.
-                        let visc = (inp.damping && k.damp2 > 0.0)
-                            .then(|| k.damp2 * self.geo.mean_edge[e] * k.sqrt_rho_e);
+                        let visc =
+                            (inp.damping && k.damp2 > 0.0).then(|| self.viscous_coefficient(e));
                         let model = &*self.models[mi];
                         // The built-in elastic law inline, any other through its trait.
                         macro_rules! element {
@@ -843,14 +842,7 @@ impl<D: Dim> Physics<D> for Mechanics {
                         match k.elastic {
                             Some((l, m2)) => {
                                 element!(|x: &ModelInput<'_>, sig: &mut Sym6, _: &mut [f64]| {
-                                    let de = x.dstrain;
-                                    let tr = de[0] + de[1] + de[2];
-                                    for c in 0..3 {
-                                        sig[c] += l * tr + m2 * de[c];
-                                    }
-                                    for c in 3..6 {
-                                        sig[c] += m2 * de[c];
-                                    }
+                                    add_hooke(l, m2, x.dstrain, sig)
                                 })
                             }
                             None => {

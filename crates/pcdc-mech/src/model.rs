@@ -360,16 +360,9 @@ impl LinearElastic {
 
     /// σ = λ tr(ε) I + 2μ ε for a strain tensor.
     pub fn stress_of(&self, e: &Sym6) -> Sym6 {
-        let (l, m) = (self.lambda(), self.shear());
-        let tr = e[0] + e[1] + e[2];
-        [
-            l * tr + 2.0 * m * e[0],
-            l * tr + 2.0 * m * e[1],
-            l * tr + 2.0 * m * e[2],
-            2.0 * m * e[3],
-            2.0 * m * e[4],
-            2.0 * m * e[5],
-        ]
+        let mut s = [0.0; 6];
+        add_hooke(self.lambda(), 2.0 * self.shear(), e, &mut s);
+        s
     }
 }
 
@@ -397,10 +390,7 @@ impl ConstitutiveModel for LinearElastic {
     }
     #[inline]
     fn update(&self, _strain: &Sym6, de: &Sym6, stress: &mut Sym6, _state: &mut [f64]) {
-        let ds = self.stress_of(de);
-        for k in 0..6 {
-            stress[k] += ds[k];
-        }
+        add_hooke(self.lambda(), 2.0 * self.shear(), de, stress);
     }
     fn wgsl(&self) -> Option<WgslModel> {
         Some(WgslModel {
@@ -420,6 +410,20 @@ impl ConstitutiveModel for LinearElastic {
             t[i + 3][i + 3] = 2.0 * m;
         }
         Some(t)
+    }
+}
+
+/// `σ += λ tr(ε) I + 2μ ε` (eq. 20-24) with λ and 2μ given (Pa): [`LinearElastic`]'s
+/// update, which the element loop of [`crate::Mechanics`] applies inline with the
+/// moduli cached.
+#[inline(always)]
+pub(crate) fn add_hooke(lambda: f64, two_mu: f64, e: &Sym6, stress: &mut Sym6) {
+    let tr = e[0] + e[1] + e[2];
+    for k in 0..3 {
+        stress[k] += lambda * tr + two_mu * e[k];
+    }
+    for k in 3..6 {
+        stress[k] += two_mu * e[k];
     }
 }
 
