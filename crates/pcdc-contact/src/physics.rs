@@ -1246,6 +1246,24 @@ impl<D: Dim> Physics<D> for Contact {
             let n = (count[e] as usize).min(cap);
             &cand[e * cap..e * cap + n]
         };
+        // Whether candidate f of (unsealed) element e skips the narrow phase this step,
+        // the same in 2D and 3D: a sealed neighbour, boxes apart (the potential's own
+        // first test, taken before the costlier checks: no force, and the pair's history
+        // `state` restarts), a shared intact vertex, or an intact bond (see the
+        // `exclusion` module).
+        let skip = |e: usize, f: usize, state: &mut [f64]| {
+            if sealed[f] {
+                return true;
+            }
+            if boxes_apart(bx(e), bx(f), dim) {
+                model.separate(state);
+                return true;
+            }
+            regions.is_some_and(|r| r.share_intact_vertex(e, f))
+                || bonds
+                    .and_then(|b| b.face(e, f))
+                    .is_some_and(|face| broken[face] == 0.0)
+        };
         if dim == 3 {
             // Tetrahedra: 4 nodes x 3 components of slots per element.
             let mean_edge3 = |e: usize| {
@@ -1271,25 +1289,11 @@ impl<D: Dim> Physics<D> for Contact {
                         let me = Self::element_xyz(kin, e);
                         for (k, &f) in list(e).iter().enumerate() {
                             let f = f as usize;
-                            if sealed[f] {
-                                continue;
-                            }
                             let state = &mut slip[k * stride..k * stride + ns];
-                            if boxes_apart(bx(e), bx(f), 3) {
-                                // The potential's own first test, before the costlier
-                                // exclusion checks: no force, fresh history.
-                                model.separate(state);
+                            if skip(e, f, state) {
                                 continue;
                             }
                             let other = Self::element_xyz(kin, f);
-                            if regions.is_some_and(|r| r.share_intact_vertex(e, f)) {
-                                continue;
-                            }
-                            if let Some(face) = bonds.and_then(|b| b.face(e, f)) {
-                                if broken[face] == 0.0 {
-                                    continue;
-                                }
-                            }
                             let (c, t, ci, ti) = if e < f {
                                 (&me, &other, e, f)
                             } else {
@@ -1338,26 +1342,12 @@ impl<D: Dim> Physics<D> for Contact {
                     let me = Self::element_xy(kin, e);
                     for (k, &f) in list(e).iter().enumerate() {
                         let f = f as usize;
-                        if sealed[f] {
-                            continue;
-                        }
                         let state = &mut slip[k * stride..k * stride + ns];
-                        if boxes_apart(bx(e), bx(f), 2) {
-                            // The potential's own first test, before the costlier
-                            // exclusion checks: no force, fresh history.
-                            model.separate(state);
+                        // Bonded neighbours interact through their joint until it breaks.
+                        if skip(e, f, state) {
                             continue;
                         }
                         let other = Self::element_xy(kin, f);
-                        if regions.is_some_and(|r| r.share_intact_vertex(e, f)) {
-                            continue;
-                        }
-                        // Bonded neighbours interact through their joint until it breaks.
-                        if let Some(face) = bonds.and_then(|b| b.face(e, f)) {
-                            if broken[face] == 0.0 {
-                                continue;
-                            }
-                        }
                         // Canonical order: the lower index is the contactor.
                         let (c, t, ci, ti) = if e < f {
                             (&me, &other, e, f)
