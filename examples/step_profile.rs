@@ -62,7 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .arg(
             Arg::new("steps")
                 .long("steps")
-                .value_parser(value_parser!(u64))
+                .value_parser(value_parser!(u64).range(1..))
                 .default_value("1000")
                 .help("Measured steps"),
         )

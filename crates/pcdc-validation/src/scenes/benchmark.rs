@@ -15,7 +15,7 @@
 //! cell size), far below the joints' stable step, as in the reference runs.
 
 use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE};
-use pcdc_compute::{Backend, Simulation};
+use pcdc_compute::{Backend, ComputeError, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, split_nodes, Dim, Dim2, Dim3, Mesh, Range};
@@ -59,6 +59,14 @@ fn build<D: Dim>(
     Ok(b.physics(boundary).time_step(0.05 * h / c_p).build()?)
 }
 
+/// A scene needs at least one cell across.
+fn at_least_one_cell(cells: usize) -> Result<(), SceneError> {
+    if cells == 0 {
+        return Err(ComputeError::param("cells across", cells, "must be at least 1").into());
+    }
+    Ok(())
+}
+
 /// The 2D benchmark block with `cells_x` cells across (2 `cells_x`² cells of two
 /// triangles: 50 → 10 000 triangles, 112 → 50 176, 224 → 200 704).
 pub fn fdem_block_2d(
@@ -66,6 +74,7 @@ pub fn fdem_block_2d(
     backend: Backend,
     contact: bool,
 ) -> Result<Simulation<Dim2>, SceneError> {
+    at_least_one_cell(cells_x)?;
     let h = 0.05 / cells_x as f64;
     let mesh = builders::rectangle(0.0, 0.0, 0.05, 0.10, h)?;
     let split = split_nodes(&mesh, &Range::All)?;
@@ -82,6 +91,7 @@ pub fn fdem_cuboid_3d(
     backend: Backend,
     contact: bool,
 ) -> Result<Simulation<Dim3>, SceneError> {
+    at_least_one_cell(cells)?;
     let h = 0.05 / cells as f64;
     let mesh = builders::cuboid([0.0; 3], [0.05, 0.05, 0.10], h)?;
     let split = split_nodes(&mesh, &Range::All)?;
@@ -109,6 +119,18 @@ mod tests {
             assert_eq!(s3.mesh().n_elements(), 6 * 2 * 2 * 4);
             s3.run(20).unwrap();
             assert!(s3.kinematics().u.iter().any(|&x| x < 0.0));
+        }
+    }
+
+    /// Zero cells across is a named parameter error, not a mesh-size message.
+    #[test]
+    fn zero_cells_is_named() {
+        for e in [
+            fdem_block_2d(0, Backend::cpu(1).unwrap(), false).err(),
+            fdem_cuboid_3d(0, Backend::cpu(1).unwrap(), true).err(),
+        ] {
+            let msg = e.expect("zero cells must fail").to_string();
+            assert!(msg.contains("cells across"), "{msg}");
         }
     }
 }

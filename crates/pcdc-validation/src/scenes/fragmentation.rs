@@ -25,7 +25,7 @@ use std::time::Instant;
 
 use pcdc::fdem::Fdem;
 use pcdc_cohesive::IntrinsicCzmParams;
-use pcdc_compute::{Backend, Simulation};
+use pcdc_compute::{Backend, Fingerprint, Simulation};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, LinearElastic};
 use pcdc_mesh::{builders, split_nodes, Dim2, Mesh, Range};
@@ -95,8 +95,8 @@ pub struct Outcome {
     pub dt: f64,
     /// Wall time (s).
     pub wall_s: f64,
-    /// FNV-1a hash of the bits of the final displacements and velocities: equal hashes
-    /// mean bit-identical runs (e.g. on different thread counts).
+    /// Hash ([`Fingerprint`]) of the bits of the final displacements and velocities:
+    /// equal hashes mean bit-identical runs (e.g. on different thread counts).
     pub state_hash: u64,
     /// (step, relative excess, relative penetration) at each check.
     pub history: Vec<(u64, f64, f64)>,
@@ -218,13 +218,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         .count();
     out.steps = sim.state.step;
     let kin = sim.kinematics();
-    out.state_hash = kin
-        .u
-        .iter()
-        .chain(kin.v)
-        .fold(0xcbf2_9ce4_8422_2325, |h, x| {
-            (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3)
-        });
+    out.state_hash = Fingerprint::new().f64s(kin.u).f64s(kin.v).finish();
     out.wall_s = start.elapsed().as_secs_f64();
     Ok(out)
 }
