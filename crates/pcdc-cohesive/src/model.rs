@@ -449,6 +449,10 @@ struct Derived {
     inv_st: f64,
     /// tan φ.
     tan_phi: f64,
+    /// h / o_p = P_open / (2 T_s): with 1/h, the pre-peak curve without a division.
+    inv_op_h: f64,
+    /// h / s_p = P_tan / (2 c).
+    inv_sp_h: f64,
 }
 
 impl Derived {
@@ -462,6 +466,8 @@ impl Derived {
             inv_ot: 1.0 / (p.gf1 / (p.tensile_strength * softening_work)),
             inv_st: 1.0 / (p.gf2 / (p.cohesion * softening_work)),
             tan_phi: p.friction_deg.to_radians().tan(),
+            inv_op_h: p.penalty_open / (2.0 * p.tensile_strength),
+            inv_sp_h: p.penalty_shear / (2.0 * p.cohesion),
         }
     }
 }
@@ -625,9 +631,16 @@ impl IntrinsicCzm {
         state: &mut [f64],
     ) -> Traction {
         use czm_state::*;
+        // One bounds check for the four state values (the joints allocate LEN per point).
+        let state = state
+            .first_chunk_mut::<LEN>()
+            .expect("intrinsic CZM state has LEN values");
         let dv = self.derived;
+        // 1/h is the same at every Gauss point of a joint (computed once when inlined);
+        // with 1/o_p and 1/s_p as products the undamaged path divides by nothing.
         let inv_h = 1.0 / h;
         let (op, sp) = (dv.op_h * h, dv.sp_h * h);
+        let (inv_op, inv_sp) = (dv.inv_op_h * inv_h, dv.inv_sp_h * inv_h);
         // Damage (eq. 68), irreversible. Before the peak in both modes nothing is
         // evaluated beyond comparisons: an undamaged joint pays no exp/pow.
         let mut d = state[DAMAGE];
@@ -668,25 +681,25 @@ impl IntrinsicCzm {
         } else if ou > op && o < ou {
             f * ts * o / ou
         } else if o <= op {
-            rising(o * inv_h / dv.op_h) * f * ts
+            rising(o * inv_op) * f * ts
         } else {
             f * ts
         };
         // Shear strength: Mohr-Coulomb with the softened cohesion (eq. 64).
         let strength = (-normal * dv.tan_phi + f * self.params.cohesion).max(0.0);
-        let shear = if su > sp && slip < su {
-            strength * slip / su
+        // The shear traction is (τ / |s|) s; τ / |s| per branch: unloading τ = strength
+        // |s| / s_u, rising τ = x (2 − x) strength with x = |s| / s_p (so τ / |s| = (2 − x)
+        // strength / s_p, no division, and finite at |s| = 0), softened τ = strength.
+        let scale = if su > sp && slip < su {
+            strength / su
         } else if slip <= sp {
-            rising(slip * inv_h / dv.sp_h) * strength
+            (2.0 - slip * inv_sp) * strength * inv_sp
         } else {
-            strength
+            strength / slip
         };
         let mut sv = [0.0; 3];
-        if slip > 0.0 {
-            let scale = shear / slip;
-            for (k, v) in slip_vec.iter().enumerate() {
-                sv[k] = scale * v;
-            }
+        for (k, v) in slip_vec.iter().enumerate() {
+            sv[k] = scale * v;
         }
         Traction { normal, shear: sv }
     }
@@ -729,7 +742,8 @@ impl JointModel for IntrinsicCzm {
         state[czm_state::DAMAGE]
     }
 
-    /// Parameters: o_p/h, s_p/h, 1/o_t, 1/s_t, tan φ, T_s (Pa), c (Pa), P_overlap (Pa).
+    /// Parameters: o_p/h, s_p/h, 1/o_t, 1/s_t, tan φ, T_s (Pa), c (Pa), P_overlap (Pa),
+    /// h/o_p, h/s_p.
     fn wgsl(&self) -> Option<WgslJointModel> {
         let dv = self.derived;
         Some(WgslJointModel {
@@ -744,6 +758,8 @@ impl JointModel for IntrinsicCzm {
                 self.params.tensile_strength,
                 self.params.cohesion,
                 self.params.penalty_overlap,
+                dv.inv_op_h,
+                dv.inv_sp_h,
             ],
         })
     }

@@ -53,14 +53,17 @@ pub fn polar_2d_h(h: &[f64; 4]) -> (f64, f64, f64) {
     let s = h[2] - h[1];
     let r = (c * c + s * s).sqrt();
     if r > 0.0 {
-        let co = c / r;
         // The cancellation-free form needs c ≥ 0; beyond a quarter turn co − 1 has none.
-        let cm1 = if c >= 0.0 {
-            -(s * s) / (r * (c + r))
+        // One division per element: q = 1 / (r (c + r)) gives 1/r = (c + r) q.
+        if c >= 0.0 {
+            let q = 1.0 / (r * (c + r));
+            let inv_r = (c + r) * q;
+            (c * inv_r, s * inv_r, -(s * s) * q)
         } else {
-            co - 1.0
-        };
-        (co, s / r, cm1)
+            let inv_r = 1.0 / r;
+            let co = c * inv_r;
+            (co, s * inv_r, co - 1.0)
+        }
     } else {
         (1.0, 0.0, 0.0)
     }

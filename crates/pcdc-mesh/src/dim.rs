@@ -88,8 +88,10 @@ impl Dim for Dim2 {
         let (dx, dy) = (x[2] - x[0], x[3] - x[1]);
         let len = (dx * dx + dy * dy).sqrt();
         if len > 0.0 {
-            normal[0] = dy / len;
-            normal[1] = -dx / len;
+            // One division for both components (the joint loop's hot path).
+            let inv = 1.0 / len;
+            normal[0] = dy * inv;
+            normal[1] = -dx * inv;
         } else {
             normal[0] = 0.0;
             normal[1] = 0.0;
@@ -129,8 +131,10 @@ impl Dim for Dim3 {
             a[0] * b[1] - a[1] * b[0],
         ];
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        // One division for the three components.
+        let inv = if len > 0.0 { 1.0 / len } else { 0.0 };
         for k in 0..3 {
-            normal[k] = if len > 0.0 { n[k] / len } else { 0.0 };
+            normal[k] = n[k] * inv;
         }
         0.5 * len
     }

@@ -1,7 +1,8 @@
 // Intrinsic cohesive zone model (manual eq. 63-73): the arithmetic of
 // `IntrinsicCzm::traction`, in the same order. Before the peak in both modes nothing
 // beyond comparisons is evaluated: an undamaged joint pays no `softening`.
-// Parameters: o_p/h, s_p/h, 1/o_t, 1/s_t, tan φ, T_s (Pa), c (Pa), P_overlap (Pa).
+// Parameters: o_p/h, s_p/h, 1/o_t, 1/s_t, tan φ, T_s (Pa), c (Pa), P_overlap (Pa),
+// h/o_p, h/s_p.
 // State: damage D, largest opening o_u, largest slip s_u, failure mode code.
 let op_h = param(p, 0u);
 let sp_h = param(p, 1u);
@@ -11,10 +12,14 @@ let tan_phi = param(p, 4u);
 let ts = param(p, 5u);
 let coh = param(p, 6u);
 let p_overlap = param(p, 7u);
+let inv_op_h = param(p, 8u);
+let inv_sp_h = param(p, 9u);
 let inv_h = 1.0 / h;
 let s = slip_norm;
 let op = op_h * h;
 let sp = sp_h * h;
+let inv_op = inv_op_h * inv_h;
+let inv_sp = inv_sp_h * inv_h;
 // Damage (eq. 68), irreversible.
 var d = (*state)[0];
 if o > op || s > sp {
@@ -57,29 +62,26 @@ if o < 0.0 {
 } else if ou > op && o < ou {
     normal = f * ts * o / ou;
 } else if o <= op {
-    let x = o * inv_h / op_h;
+    let x = o * inv_op;
     normal = x * (2.0 - x) * f * ts;
 } else {
     normal = f * ts;
 }
 // Shear strength: Mohr-Coulomb with the softened cohesion (eq. 64).
 let strength = max(-normal * tan_phi + f * coh, 0.0);
-var shear: Real;
+// The shear traction (τ / |s|) s, τ / |s| per branch (no division before the peak).
+var scale: Real;
 if su > sp && s < su {
-    shear = strength * s / su;
+    scale = strength / su;
 } else if s <= sp {
-    let x = s * inv_h / sp_h;
-    shear = x * (2.0 - x) * strength;
+    scale = (2.0 - s * inv_sp) * strength * inv_sp;
 } else {
-    shear = strength;
+    scale = strength / s;
 }
 var t: JointTraction;
 t.normal = normal;
-if s > 0.0 {
-    let scale = shear / s;
-    for (var k = 0u; k < D; k = k + 1u) {
-        t.shear[k] = scale * slip[k];
-    }
+for (var k = 0u; k < D; k = k + 1u) {
+    t.shear[k] = scale * slip[k];
 }
 t.damage = (*state)[0];
 return t;

@@ -30,11 +30,17 @@ fn kernel(e: u32) {
     var si = Real(0.0);
     var cm1 = Real(0.0);
     if pr > 0.0 {
-        co = pc / pr;
-        si = ps / pr;
+        // One division: q = 1 / (r (c + r)) gives 1/r = (c + r) q.
         if pc >= 0.0 {
-            cm1 = -(ps * ps) / (pr * (pc + pr));
+            let q = 1.0 / (pr * (pc + pr));
+            let inv_r = (pc + pr) * q;
+            co = pc * inv_r;
+            si = ps * inv_r;
+            cm1 = -(ps * ps) * q;
         } else {
+            let inv_r = 1.0 / pr;
+            co = pc * inv_r;
+            si = ps * inv_r;
             cm1 = co - 1.0;
         }
     }

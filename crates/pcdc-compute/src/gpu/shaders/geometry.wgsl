@@ -9,8 +9,9 @@ fn face_measure_normal(x: array<Real, 9>, n: ptr<function, array<Real, 3>>) -> R
         let dy = x[3] - x[1];
         let len = sqrt(dx * dx + dy * dy);
         if len > 0.0 {
-            (*n)[0] = dy / len;
-            (*n)[1] = -dx / len;
+            let inv = 1.0 / len;
+            (*n)[0] = dy * inv;
+            (*n)[1] = -dx * inv;
         }
         return len;
     }
@@ -25,9 +26,10 @@ fn face_measure_normal(x: array<Real, 9>, n: ptr<function, array<Real, 3>>) -> R
     let c2 = a0 * b1 - a1 * b0;
     let len = sqrt(c0 * c0 + c1 * c1 + c2 * c2);
     if len > 0.0 {
-        (*n)[0] = c0 / len;
-        (*n)[1] = c1 / len;
-        (*n)[2] = c2 / len;
+        let inv = 1.0 / len;
+        (*n)[0] = c0 * inv;
+        (*n)[1] = c1 * inv;
+        (*n)[2] = c2 * inv;
     }
     return 0.5 * len;
 }
