@@ -40,7 +40,7 @@ use std::sync::Arc;
 
 use pcdc_compute::coupling::CouplingInputs;
 use pcdc_compute::gpu::{splice_models, Access, GpuData, GpuSetup, Kernel, Phase, WGSL_GEOMETRY};
-use pcdc_compute::{Backend, FieldKey, FieldUse};
+use pcdc_compute::{Backend, FieldKey, FieldUse, KinematicNodes};
 use pcdc_compute::{
     ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
     StableStep,
@@ -346,13 +346,13 @@ impl CohesiveJoints {
         let mut mid = [0.0; 9];
         let mut gap = [0.0; 9];
         for k in 0..npf {
+            let (xa, xb) = (
+                kin.position(nodes[k] as usize),
+                kin.position(nodes[npf + k] as usize),
+            );
             for c in 0..d {
-                let (xa, xb) = (
-                    kin.x(nodes[k] as usize, c),
-                    kin.x(nodes[npf + k] as usize, c),
-                );
-                mid[k * d + c] = 0.5 * (xa + xb);
-                gap[k * d + c] = xb - xa;
+                mid[k * d + c] = 0.5 * (xa[c] + xb[c]);
+                gap[k * d + c] = xb[c] - xa[c];
             }
         }
         let mut n = [0.0; 3];
@@ -371,9 +371,14 @@ impl CohesiveJoints {
             o += g[c] * n[c];
         }
         *out.opening = o;
-        for c in 0..d {
-            out.sliding[c] = g[c] - o * n[c];
-            out.normal[c] = n[c];
+        for ((sl, nm), (&gc, &nc)) in out
+            .sliding
+            .iter_mut()
+            .zip(out.normal.iter_mut())
+            .zip(g.iter().zip(&n))
+        {
+            *sl = gc - o * nc;
+            *nm = nc;
         }
         if broken {
             // No force: contact alone acts between its faces.
@@ -397,7 +402,7 @@ impl CohesiveJoints {
                 gt[k] = gap[2 * k] * tg[0] + gap[2 * k + 1] * tg[1];
             }
         }
-        for (g, (shape, w)) in self.rule.iter().enumerate() {
+        let mut point = |shape: &[f64; 3], w: f64, st: &mut [f64]| {
             let mut s = [0.0; 3];
             let (o, slip_norm) = if d == 2 {
                 let o = shape[0] * gn[0] + shape[1] * gn[1];
@@ -419,7 +424,6 @@ impl CohesiveJoints {
                 }
                 (o, slip_norm(&s[..d]))
             };
-            let st = &mut state[g * ns..(g + 1) * ns];
             let input = JointInput {
                 opening: o,
                 slip: &s[..d],
@@ -439,12 +443,24 @@ impl CohesiveJoints {
                     fa[k * d + c] += wk * tv[c];
                 }
             }
+        };
+        // 2D: the three points as a fixed-size array, so the loop unrolls and what the
+        // inlined model computes from h alone (1/h) is computed once per joint.
+        if d == 2 {
+            let rule: &[([f64; 3], f64); 3] = self.rule[..].try_into().expect("3 points in 2D");
+            for ((shape, w), st) in rule.iter().zip(state.chunks_exact_mut(ns)) {
+                point(shape, *w, st);
+            }
+        } else {
+            for ((shape, w), st) in self.rule.iter().zip(state.chunks_exact_mut(ns)) {
+                point(shape, *w, st);
+            }
         }
-        let n = npf * d;
-        for i in 0..n {
-            let f = area * fa[i];
-            slots[i] = f;
-            slots[n + i] = -f;
+        let (side_a, side_b) = slots.split_at_mut(npf * d);
+        for ((sa, sb), &f) in side_a.iter_mut().zip(side_b).zip(&fa) {
+            let f = area * f;
+            *sa = f;
+            *sb = -f;
         }
         Some(damage)
     }
@@ -453,6 +469,14 @@ impl CohesiveJoints {
 impl<D: Dim> Physics<D> for CohesiveJoints {
     fn name(&self) -> &str {
         "cohesive joints"
+    }
+
+    fn kinematic_nodes(&self) -> KinematicNodes {
+        KinematicNodes::None
+    }
+
+    fn writes_all_slots(&self) -> bool {
+        true
     }
 
     fn fingerprint(&self) -> u64 {

@@ -31,6 +31,7 @@ mod field;
 mod fingerprint;
 pub mod gpu;
 mod history;
+mod node_pass;
 mod physics;
 mod simulation;
 pub mod snapshot;
@@ -52,7 +53,8 @@ pub use gpu::WgpuBackend;
 pub use history::{History, Probe};
 pub use physics::{
     DofConstraint, Entity, EntityKind, FieldContext, FieldSchedule, ForceContext, InitContext,
-    Kinematics, NodeBlock, Physics, PhysicsGroup, SlotBlock, StableStep, SubCycle, VelocityContext,
+    KinematicNodes, Kinematics, NodeBlock, Physics, PhysicsGroup, SlotBlock, StableStep, SubCycle,
+    VelocityContext,
 };
 pub use simulation::{Simulation, SimulationBuilder, State, DEFAULT_SAFETY};
 pub use stages::{FieldStage, MAX_SUBCYCLE};

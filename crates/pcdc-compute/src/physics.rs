@@ -183,6 +183,19 @@ impl<D: Dim> Kinematics<'_, D> {
     pub fn x(&self, n: usize, k: usize) -> f64 {
         self.coords[n * D::D + k] + self.u[n * D::D + k]
     }
+
+    /// Current position of node `n` (m): the first `D` components (the rest zero), with
+    /// one bounds check per array instead of one per component.
+    #[inline(always)]
+    pub fn position(&self, n: usize) -> [f64; 3] {
+        let d = D::D;
+        let (x, u) = (&self.coords[n * d..n * d + d], &self.u[n * d..n * d + d]);
+        let mut p = [0.0; 3];
+        for k in 0..d {
+            p[k] = x[k] + u[k];
+        }
+        p
+    }
 }
 
 /// Context given to [`Physics::init`].
@@ -288,11 +301,26 @@ pub struct ForceContext<'a, D: Dim> {
     pub backend: &'a Backend,
 }
 
+/// Which node velocities a physics' [`Physics::apply_kinematics`] writes
+/// ([`Physics::kinematic_nodes`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum KinematicNodes {
+    /// None: the physics imposes no kinematic condition.
+    None,
+    /// Only these nodes' velocities (indices into all nodes, mesh nodes first; any
+    /// order, repeats allowed).
+    Nodes(Vec<u32>),
+    /// Any node's velocity (the default).
+    Any,
+}
+
 /// Context given to [`Physics::apply_kinematics`] after the velocity update.
 pub struct VelocityContext<'a, D: Dim> {
     /// The mesh.
     pub mesh: &'a Mesh<D>,
-    /// Node displacement at the start of the step (m).
+    /// Node displacement at the start of the step (m) at the nodes this physics names
+    /// in [`Physics::kinematic_nodes`] (all nodes with [`KinematicNodes::Any`]); at the
+    /// other nodes it may already hold the end of the step's value.
     pub u: &'a [f64],
     /// Node velocity just integrated (m/s): overwrite prescribed components here.
     pub v: &'a mut [f64],
@@ -418,6 +446,18 @@ pub trait Physics<D: Dim>: Send + Sync {
     /// integrated velocities.
     fn apply_kinematics(&mut self, _ctx: &mut VelocityContext<'_, D>) {}
 
+    /// The nodes whose velocity [`Physics::apply_kinematics`] writes, asked once after
+    /// [`Physics::init`]. When every physics of a composition names its nodes (or
+    /// [`KinematicNodes::None`]), the CPU step moves every other node in the pass that
+    /// gathers its forces and integrates its velocity (the node arrays are read once per
+    /// step, not twice) and moves the named ones after the kinematic conditions; the
+    /// result is the same. The default, [`KinematicNodes::Any`], keeps the two passes:
+    /// right for any physics, and what a physics that writes velocities without saying
+    /// where must return.
+    fn kinematic_nodes(&self) -> KinematicNodes {
+        KinematicNodes::Any
+    }
+
     /// Adds the linear (small-displacement) stiffness of this physics as triplets
     /// `(row dof, col dof, value)`, dof = node * D + component, for the direct static
     /// solve. `Ok(false)` means the physics has no stiffness; the default refuses.
@@ -500,6 +540,13 @@ pub trait Physics<D: Dim>: Send + Sync {
     /// the energy balance counts their work as external work instead of energy the
     /// physics absorbs (default: internal forces of a body).
     fn applies_loads(&self) -> bool {
+        false
+    }
+
+    /// Whether [`Physics::compute_forces`] writes every value of its slot block every
+    /// step (zeros included), so the engine need not clear the block before it; the
+    /// default `false` has the block cleared, and a physics may then add into it.
+    fn writes_all_slots(&self) -> bool {
         false
     }
 

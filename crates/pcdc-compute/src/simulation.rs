@@ -7,12 +7,11 @@
 //! (manual 7.1 eq. iv); prescribed kinematics; `u += dt v` (eq. v); watchdog.
 
 use pcdc_mesh::{Dim, Mesh};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::energy::EnergyTracker;
 use crate::gpu::GpuRun;
-use crate::physics::{ForceContext, InitContext, Kinematics, VelocityContext};
+use crate::physics::{ForceContext, InitContext, Kinematics};
 use crate::{Backend, ComputeError, FieldAccess, FieldStore, Physics, StableStep};
 
 /// Default safety factor applied to the critical time step.
@@ -252,7 +251,9 @@ impl<D: Dim> SimulationBuilder<D> {
             local_damping,
             energy: None,
             field_stages: Vec::new(),
+            kinematic_nodes: None,
         };
+        sim.kinematic_nodes = crate::node_pass::kinematic_nodes(&sim.physics, n_nodes)?;
         if let Some(tol) = energy {
             let loads: Vec<bool> = sim.physics.iter().map(|p| p.applies_loads()).collect();
             sim.energy = Some(Box::new(EnergyTracker::new(
@@ -498,6 +499,9 @@ pub struct Simulation<D: Dim> {
     pub(crate) energy: Option<Box<EnergyTracker>>,
     /// Schedule of each physics' field stage (`None`: it has none), fixed at build.
     pub(crate) field_stages: Vec<Option<crate::FieldStage>>,
+    /// The nodes whose velocity a kinematic condition writes (sorted, unique) when every
+    /// physics names them: then the CPU step fuses the node passes (`node_pass.rs`).
+    pub(crate) kinematic_nodes: Option<Vec<u32>>,
 }
 
 impl<D: Dim> Simulation<D> {
@@ -522,8 +526,12 @@ impl<D: Dim> Simulation<D> {
     fn cpu_step(&mut self) -> Result<(), ComputeError> {
         self.physics_forces()?;
         self.energy_before_update();
-        self.gather(true);
-        self.finish_step()?;
+        if self.kinematic_nodes.is_some() {
+            self.fused_node_pass()?;
+        } else {
+            self.gather(true);
+            self.finish_step()?;
+        }
         self.after_update()?;
         self.energy_after_step()
     }
@@ -617,14 +625,18 @@ impl<D: Dim> Simulation<D> {
         Ok(Some(g))
     }
 
-    /// Clears the force slots and lets every physics write its forces.
+    /// Lets every physics write its forces, clearing its slots first unless it writes
+    /// every one of them ([`Physics::writes_all_slots`]).
     fn physics_forces(&mut self) -> Result<(), ComputeError> {
         let d = D::D;
         let kin_u = &self.state.u;
         let kin_v = &self.state.v;
         let fields = &mut self.state.fields;
-        self.slot_forces.fill(0.0);
         for (p, r) in self.physics.iter_mut().zip(&self.slot_ranges) {
+            let slots = &mut self.slot_forces[r.start * d..r.end * d];
+            if !p.writes_all_slots() {
+                slots.fill(0.0);
+            }
             let mut ctx = ForceContext {
                 kin: Kinematics {
                     mesh: &self.mesh,
@@ -638,113 +650,10 @@ impl<D: Dim> Simulation<D> {
                     damping: self.damping,
                 },
                 fields,
-                slots: &mut self.slot_forces[r.start * d..r.end * d],
+                slots,
                 backend: &self.backend,
             };
             p.compute_forces(&mut ctx)?;
-        }
-        Ok(())
-    }
-
-    /// Each node sums its slots in registration order into the node force; with
-    /// `integrate_velocity` the same pass applies the central-difference velocity update
-    /// `v += dt (F + m_phys g − α|F| sign v) / m` (one pass over the nodes instead of two).
-    fn gather(&mut self, integrate_velocity: bool) {
-        let d = D::D;
-        let dt = self.dt;
-        let g = self.gravity;
-        let alpha = self.local_damping;
-        let (ptr, idx, slots) = (&self.gather_ptr, &self.gather_idx, &self.slot_forces);
-        let (mass, mass_phys) = (&self.mass, &self.mass_phys);
-        let force = &mut self.force;
-        let v = &mut self.state.v;
-        self.backend.install(|| {
-            // Blocks of nodes, plain loops inside: a per-node rayon item costs more than
-            // the node's arithmetic.
-            force
-                .par_chunks_mut(NODE_BLOCK * d)
-                .zip(v.par_chunks_mut(NODE_BLOCK * d))
-                .enumerate()
-                .for_each(|(b, (fb, vb))| {
-                    let first = b * NODE_BLOCK;
-                    for i in 0..fb.len() / d {
-                        let n = first + i;
-                        let mut sum = [0.0; 3];
-                        for &s in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
-                            for k in 0..d {
-                                sum[k] += slots[s as usize * d + k];
-                            }
-                        }
-                        // A copy of compile-time length d (a chunk of run-time length
-                        // made `copy_from_slice` call memcpy per node: 7 % of the step).
-                        fb[i * d..i * d + d].copy_from_slice(&sum[..d]);
-                        let vn = &mut vb[i * d..i * d + d];
-                        if integrate_velocity {
-                            let (m, w) = (mass[n], mass_phys[n] / mass[n]);
-                            for k in 0..d {
-                                let mut fk = sum[k] + w * m * g[k];
-                                if alpha > 0.0 {
-                                    // Local non-viscous damping (Cundall): f -= α |f| sign(v).
-                                    fk -= alpha
-                                        * fk.abs()
-                                        * vn[k].signum()
-                                        * (vn[k] != 0.0) as u8 as f64;
-                                }
-                                vn[k] += dt * fk / m;
-                            }
-                        }
-                    }
-                })
-        });
-    }
-
-    /// Kinematic conditions, position update and watchdog after the velocity update.
-    fn finish_step(&mut self) -> Result<(), ComputeError> {
-        let d = D::D;
-        let dt = self.dt;
-        let t_end = self.state.time + dt;
-        for p in &mut self.physics {
-            let mut ctx = VelocityContext {
-                mesh: &self.mesh,
-                u: &self.state.u,
-                v: &mut self.state.v,
-                time: t_end,
-                dt,
-                fields: &mut self.state.fields,
-            };
-            p.apply_kinematics(&mut ctx);
-        }
-        let limit2 = self.runaway * self.runaway;
-        let (u, v) = (&mut self.state.u, &self.state.v);
-        let bad = self.backend.install(|| {
-            u.par_chunks_mut(NODE_BLOCK * d)
-                .zip(v.par_chunks(NODE_BLOCK * d))
-                .enumerate()
-                .filter_map(|(b, (ub, vb))| {
-                    // The first bad node of the block (blocks in order: the first overall);
-                    // every node moves, as before the check.
-                    let mut bad = None;
-                    for i in 0..ub.len() / d {
-                        let mut u2 = 0.0;
-                        let mut finite = true;
-                        for k in 0..d {
-                            let j = i * d + k;
-                            ub[j] += dt * vb[j];
-                            u2 += ub[j] * ub[j];
-                            finite &= ub[j].is_finite() && vb[j].is_finite();
-                        }
-                        if bad.is_none() && (!finite || u2 > limit2) {
-                            bad = Some((b * NODE_BLOCK + i, !finite));
-                        }
-                    }
-                    bad
-                })
-                .min_by_key(|&(n, _)| n)
-        });
-        self.state.time = t_end;
-        self.state.step += 1;
-        if let Some((n, nonfinite)) = bad {
-            return Err(self.divergence(self.state.step, self.state.time, n, nonfinite));
         }
         Ok(())
     }
@@ -778,9 +687,6 @@ impl<D: Dim> Simulation<D> {
         }
     }
 }
-
-/// Nodes per parallel task of the node passes.
-const NODE_BLOCK: usize = 2048;
 
 impl<D: Dim> Simulation<D> {
     /// Read-only view of the current kinematic state (on the GPU backend: as read back at

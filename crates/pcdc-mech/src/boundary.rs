@@ -19,7 +19,7 @@ use pcdc_compute::{
     ComputeError, DofConstraint, FieldId, FieldStore, Fingerprint, ForceContext, InitContext,
     Physics, SlotBlock, TimeValue, VelocityContext,
 };
-use pcdc_compute::{FieldKey, FieldUse, Place};
+use pcdc_compute::{FieldKey, FieldUse, KinematicNodes, Place};
 use pcdc_mesh::{Dim, Mesh, Range};
 
 use crate::MechError;
@@ -359,6 +359,20 @@ fn unit<D: Dim>(d: &[f64; 3]) -> [f64; 3] {
 impl<D: Dim> Physics<D> for Boundary {
     fn name(&self) -> &str {
         NAME
+    }
+
+    fn kinematic_nodes(&self) -> KinematicNodes {
+        // The nodes of the velocity, acceleration and constraint items (resolved at init).
+        let mut nodes = Vec::new();
+        for (it, r) in self.items.iter().zip(&self.resolved) {
+            if matches!(
+                it,
+                Item::Velocity { .. } | Item::Acceleration { .. } | Item::Constraint { .. }
+            ) {
+                nodes.extend_from_slice(&r.nodes);
+            }
+        }
+        KinematicNodes::Nodes(nodes)
     }
 
     /// Face tractions and node forces are applied loads: external work.

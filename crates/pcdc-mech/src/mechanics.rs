@@ -19,7 +19,7 @@ use pcdc_compute::{
     names, ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics,
     Physics, StableStep,
 };
-use pcdc_compute::{Backend, FieldKey, FieldUse};
+use pcdc_compute::{Backend, FieldKey, FieldUse, KinematicNodes};
 use pcdc_compute::{Entity, EntityKind};
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
@@ -422,8 +422,10 @@ impl Mechanics {
         // Displacement gradient H = ∂u/∂X = [u₁ − u₀, u₂ − u₀] D_m⁻¹ and F = I + H: built
         // from displacement differences, not from current positions, so that small
         // strains keep their digits (x = X + u would round u to the ulp of X).
-        let du = |n: usize, k: usize| inp.u[n + k] - inp.u[n0 + k];
-        let (d0, d1, d2, d3) = (du(n1, 0), du(n2, 0), du(n1, 1), du(n2, 1));
+        // One bounds check per node.
+        let node = |x: &[f64], n: usize| -> [f64; 2] { [x[n], x[n + 1]] };
+        let (u0, u1, u2) = (node(inp.u, n0), node(inp.u, n1), node(inp.u, n2));
+        let (d0, d1, d2, d3) = (u1[0] - u0[0], u2[0] - u0[0], u1[1] - u0[1], u2[1] - u0[1]);
         let h = [
             d0 * m[0] + d1 * m[2],
             d0 * m[1] + d1 * m[3],
@@ -462,14 +464,8 @@ impl Mechanics {
         *szz = sig[2];
         let (mut sxx, mut syy, mut sxy) = (sig[0], sig[1], sig[3]);
         if let Some(cv) = visc {
-            let vv = |n: usize, k: usize| inp.v[n + k];
-            let (vx0, vy0) = (vv(n0, 0), vv(n0, 1));
-            let dv = [
-                vv(n1, 0) - vx0,
-                vv(n2, 0) - vx0,
-                vv(n1, 1) - vy0,
-                vv(n2, 1) - vy0,
-            ];
+            let (v0, v1, v2) = (node(inp.v, n0), node(inp.v, n1), node(inp.v, n2));
+            let dv = [v1[0] - v0[0], v2[0] - v0[0], v1[1] - v0[1], v2[1] - v0[1]];
             let fd = [
                 dv[0] * m[0] + dv[1] * m[2],
                 dv[0] * m[1] + dv[1] * m[3],
@@ -614,6 +610,14 @@ impl Mechanics {
 impl<D: Dim> Physics<D> for Mechanics {
     fn name(&self) -> &str {
         "mechanics"
+    }
+
+    fn kinematic_nodes(&self) -> KinematicNodes {
+        KinematicNodes::None
+    }
+
+    fn writes_all_slots(&self) -> bool {
+        true
     }
 
     fn fingerprint(&self) -> u64 {
@@ -808,13 +812,15 @@ impl<D: Dim> Physics<D> for Mechanics {
                 .enumerate()
                 .for_each(|(chunk, ((((sl, st), ep), ex), ms))| {
                     let first = chunk * CHUNK;
-                    let count = sl.len() / (npe * d);
-                    for i in 0..count {
+                    // Each element's outputs as exact chunks: no bounds check per value.
+                    let per_element = sl
+                        .chunks_exact_mut(npe * d)
+                        .zip(st.chunks_exact_mut(nsym))
+                        .zip(ep.chunks_exact_mut(nsym))
+                        .zip(ex.chunks_exact_mut(nx))
+                        .zip(ms.chunks_exact_mut(ns));
+                    for (i, ((((sl, st), ep), ex), ms)) in per_element.enumerate() {
                         let e = first + i;
-                        let sl = &mut sl[i * npe * d..(i + 1) * npe * d];
-                        let st = &mut st[i * nsym..(i + 1) * nsym];
-                        let ep = &mut ep[i * nsym..(i + 1) * nsym];
-                        let ms = &mut ms[i * ns..(i + 1) * ns];
                         let cv: &[f64] = if cstride == 0 {
                             &[]
                         } else {
@@ -831,10 +837,9 @@ impl<D: Dim> Physics<D> for Mechanics {
                             ($update:expr) => {
                                 if d == 2 {
                                     self.element_2d(
-                                        e, &inp, sl, st, ep, &mut ex[i], ms, cv, visc, $update,
+                                        e, &inp, sl, st, ep, &mut ex[0], ms, cv, visc, $update,
                                     );
                                 } else {
-                                    let ex = &mut ex[i * 9..i * 9 + 9];
                                     self.element_3d(e, &inp, sl, st, ep, ex, ms, cv, visc, $update);
                                 }
                             };

@@ -77,66 +77,78 @@ impl Interfaces {
     }
 
     /// Number of interfaces.
+    #[inline]
     pub fn len(&self) -> usize {
         self.elements.len() / 2
     }
 
     /// Whether there are no interfaces.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.elements.is_empty()
     }
 
     /// Nodes per side (the mesh's nodes per face: 2 in 2D, 3 in 3D).
+    #[inline]
     pub fn nodes_per_side(&self) -> usize {
         self.npf
     }
 
     /// Nodes per interface: both sides, `2 * nodes_per_side()` (4 in 2D, 6 in 3D).
+    #[inline]
     pub fn nodes_per_joint(&self) -> usize {
         2 * self.npf
     }
 
     /// Interface connectivity, stride [`Interfaces::nodes_per_joint`]: per interface side
     /// A's nodes, then side B's matching nodes.
+    #[inline]
     pub fn nodes(&self) -> &[u32] {
         &self.nodes
     }
 
     /// Nodes of interface `j`: side A's, then side B's.
+    #[inline]
     pub fn joint_nodes(&self, j: usize) -> &[u32] {
         let s = 2 * self.npf;
         &self.nodes[j * s..(j + 1) * s]
     }
 
     /// Elements on sides A and B, stride 2.
+    #[inline]
     pub fn elements(&self) -> &[u32] {
         &self.elements
     }
 
     /// Local face index of sides A and B in their elements, stride 2.
+    #[inline]
     pub fn local_faces(&self) -> &[u8] {
         &self.local_faces
     }
 
     /// Faces of the mesh on sides A and B, stride 2 (both are boundary faces of the split
     /// mesh; a face field on them, e.g. a broken flag, is seen by face-based physics).
+    #[inline]
     pub fn faces(&self) -> &[u32] {
         &self.faces
     }
 
     /// Per node, the original (master) node it was copied from by [`split_nodes`]; empty
     /// when the mesh was not split.
+    #[inline]
     pub fn master(&self) -> &[u32] {
         &self.master
     }
 
     /// The original node of node `n` (`n` itself in a mesh that was not split).
+    #[inline]
     pub fn master_of(&self, n: u32) -> u32 {
         self.master.get(n as usize).copied().unwrap_or(n)
     }
 
     /// Whether the mesh was made by [`split_nodes`] (it has a master-node map, even when
     /// no interface was cut).
+    #[inline]
     pub fn is_split(&self) -> bool {
         !self.master.is_empty()
     }

@@ -1,6 +1,6 @@
 // Gather + central-difference velocity update (one invocation per node), the same
 // arithmetic in the same order as the CPU backend:
-//   F = Σ slots (registration order),  v += dt (F + m_phys g − α|F| sign v) / m.
+//   F = Σ slots (registration order),  v += (F + m_phys g − α|F| sign v) (dt / m).
 fn kernel(n: u32) {
     var sum: array<Real, 3>;
     let a = gather_ptr[n];
@@ -11,14 +11,13 @@ fn kernel(n: u32) {
             sum[k] = sum[k] + slots[s * D + k];
         }
     }
-    let m = mass[n];
-    let w = mass_phys[n] / m;
-    let dt = p_dt();
+    let m_phys = mass_phys[n];
+    let dtm = p_dt() / mass[n];
     let alpha = p_alpha();
     for (var k = 0u; k < D; k = k + 1u) {
         let i = n * D + k;
         force[i] = sum[k];
-        var fk = sum[k] + w * m * p_gravity(k);
+        var fk = sum[k] + m_phys * p_gravity(k);
         let vk = vel[i];
         if alpha > 0.0 {
             // Local non-viscous damping (Cundall).
@@ -30,6 +29,6 @@ fn kernel(n: u32) {
             }
             fk = fk - alpha * abs(fk) * sg;
         }
-        vel[i] = vk + dt * fk / m;
+        vel[i] = vk + fk * dtm;
     }
 }
