@@ -38,6 +38,7 @@
 // Index loops mirror the formulas.
 #![allow(clippy::needless_range_loop)]
 
+mod active;
 mod exclusion;
 mod gpu;
 mod model;

@@ -72,12 +72,13 @@ use pcdc_compute::{
     ComputeError, FieldId, FieldStore, Fingerprint, ForceContext, InitContext, Kinematics, Physics,
     StableStep,
 };
-use pcdc_compute::{Entity, EntityKind};
+use pcdc_compute::{Entity, EntityKind, KinematicNodes};
 use pcdc_mesh::{Dim, Mesh};
 use rayon::prelude::*;
 
 use std::sync::Arc;
 
+use crate::active::ActiveSet;
 use crate::exclusion::BondedRegions;
 use crate::model::{ContactDamping, ContactModel, Friction, MohrCoulombContact};
 use crate::{tet_pair_force, triangle_pair_force, PairForce2, PairForce3};
@@ -273,20 +274,21 @@ pub struct Contact {
     bonds: Option<Bonds>,
     /// Vertex topology of the bonded regions (set by init when bonds are declared).
     regions: Option<BondedRegions>,
-    /// Per-step scratch (derived from the positions and the vertex flags every step).
+    /// Per-step scratch (derived from the positions every step).
     scratch: StepScratch,
+    /// Sealed flags and watched nodes (derived from the broken bonds when they change).
+    active: ActiveSet,
     skin_used: f64,
     /// The state fields (set by init).
     ids: Option<StateIds>,
 }
 
-/// What every element's candidates look up once per step: whether the element is sealed
-/// (nothing can touch it, see the `exclusion` module) and, if not, the box of its current
-/// corners (lows then highs, stride 2 D), so that the first test of the pair potential
-/// costs a few loads per candidate.
+/// What every element's candidates look up once per step besides the sealed flags
+/// ([`ActiveSet`]): the box of an unsealed element's current corners (lows then highs,
+/// stride 2 D), so that the first test of the pair potential costs a few loads per
+/// candidate.
 #[derive(Debug, Default)]
 struct StepScratch {
-    sealed: Vec<bool>,
     boxes: Vec<f64>,
 }
 
@@ -354,6 +356,7 @@ impl Contact {
             bonds: None,
             regions: None,
             scratch: StepScratch::default(),
+            active: ActiveSet::default(),
             skin_used: 0.0,
             ids: None,
         }
@@ -935,6 +938,14 @@ impl<D: Dim> Physics<D> for Contact {
         "contact"
     }
 
+    fn kinematic_nodes(&self) -> KinematicNodes {
+        KinematicNodes::None
+    }
+
+    fn writes_all_slots(&self) -> bool {
+        true
+    }
+
     fn fields(&self, mesh: &Mesh<D>) -> Vec<FieldUse> {
         let capacity = self.capacity_for(mesh);
         let stride = self.law().n_state().max(1);
@@ -1155,15 +1166,23 @@ impl<D: Dim> Physics<D> for Contact {
         let ids = self.ids.expect("init ran");
         let ns = self.n_state;
         let kin = &ctx.kin;
-        // Rebuild when any node moved more than half the skin since the last build (a
-        // NaN reference, before the first build, always does).
+        // Where contact can happen this step (see the `exclusion` and `active` modules).
+        let broken_id = self.bonds.as_ref().and_then(|b| b.id);
+        let broken: &[f64] = broken_id.map_or(&[], |b| ctx.fields.get(b));
+        let active = &mut self.active;
+        let regions = self.regions.as_mut();
+        ctx.backend
+            .install(|| active.refresh(regions, broken, kin.mesh));
+        // Rebuild when a node of an unsealed element moved more than half the skin since
+        // the last build (a NaN reference, before the first build, always does).
         let limit2 = (0.5 * self.skin_used).powi(2);
         let dim = D::D;
         let reference = ctx.fields.get(ids.reference);
-        let nn = kin.mesh.n_nodes();
+        let watched = &self.active.nodes;
         let moved = ctx.backend.install(|| {
-            (0..nn.div_ceil(4096)).into_par_iter().any(|b| {
-                (4096 * b..(4096 * (b + 1)).min(nn)).any(|n| {
+            watched.par_chunks(4096).any(|block| {
+                block.iter().any(|&n| {
+                    let n = n as usize;
                     let mut d2 = 0.0;
                     for k in 0..dim {
                         let dk = kin.x(n, k) - reference[dim * n + k];
@@ -1187,41 +1206,34 @@ impl<D: Dim> Physics<D> for Contact {
         let (cap, stride) = (ids.capacity, ids.stride);
         let model = self.model.as_deref().expect("init ran");
         let bonds = self.bonds.as_ref();
-        let (count, cand, hist, broken): (&[f64], &[f64], &mut [f64], &[f64]) =
-            match bonds.and_then(|b| b.id) {
-                Some(bid) => {
-                    let [n, c, h, b] =
-                        ctx.fields
-                            .get_many_mut([ids.count, ids.candidates, ids.history, bid]);
-                    (n, c, h, b)
-                }
-                None => {
-                    let [n, c, h] =
-                        ctx.fields
-                            .get_many_mut([ids.count, ids.candidates, ids.history]);
-                    (n, c, h, &[])
-                }
-            };
-        // Where contact can happen this step (see the `exclusion` module).
-        if let Some(r) = &mut self.regions {
-            ctx.backend.install(|| r.update(broken));
-        }
+        let (count, cand, hist, broken): (&[f64], &[f64], &mut [f64], &[f64]) = match broken_id {
+            Some(bid) => {
+                let [n, c, h, b] =
+                    ctx.fields
+                        .get_many_mut([ids.count, ids.candidates, ids.history, bid]);
+                (n, c, h, b)
+            }
+            None => {
+                let [n, c, h] = ctx
+                    .fields
+                    .get_many_mut([ids.count, ids.candidates, ids.history]);
+                (n, c, h, &[])
+            }
+        };
         let regions = self.regions.as_ref();
-        // Sealed flags and current boxes, once per element and step.
+        // Current boxes of the unsealed elements, once per element and step.
         let ne = kin.mesh.n_elements();
         let mut scratch = std::mem::take(&mut self.scratch);
-        scratch.sealed.resize(ne, false);
         scratch.boxes.resize(ne * 2 * dim, 0.0);
+        let sealed = &self.active.sealed;
         ctx.backend.install(|| {
             scratch
-                .sealed
-                .par_iter_mut()
-                .zip(scratch.boxes.par_chunks_mut(2 * dim))
+                .boxes
+                .par_chunks_mut(2 * dim)
                 .enumerate()
                 .with_min_len(1024)
-                .for_each(|(e, (sealed, b))| {
-                    *sealed = regions.is_some_and(|r| r.sealed(e));
-                    if *sealed {
+                .for_each(|(e, b)| {
+                    if sealed[e] {
                         return;
                     }
                     let nodes = kin.mesh.element(e);
@@ -1238,7 +1250,7 @@ impl<D: Dim> Physics<D> for Contact {
                     }
                 })
         });
-        let (sealed, boxes) = (&scratch.sealed, &scratch.boxes);
+        let boxes = &scratch.boxes;
         let bx = |e: usize| &boxes[2 * dim * e..2 * dim * (e + 1)];
         // Element e's list: the first n entries of its row (n checked on restore; the
         // clamp keeps a hand-edited count in bounds).
@@ -1283,6 +1295,8 @@ impl<D: Dim> Physics<D> for Contact {
                     .zip(hist.par_chunks_mut(cap * stride))
                     .enumerate()
                     .for_each(|(e, (slot, slip))| {
+                        // Every slot written (`writes_all_slots`): zero, then the pairs.
+                        slot.fill(0.0);
                         if sealed[e] {
                             return;
                         }
@@ -1335,6 +1349,8 @@ impl<D: Dim> Physics<D> for Contact {
                 .zip(hist.par_chunks_mut(cap * stride))
                 .enumerate()
                 .for_each(|(e, (slot, slip))| {
+                    // Every slot written (`writes_all_slots`): zero, then the pairs.
+                    slot.fill(0.0);
                     // Inside intact rock nothing can touch (see the `exclusion` module).
                     if sealed[e] {
                         return;
