@@ -11,7 +11,9 @@
 //! assembly, bonded-neighbour exclusion for FDEM regions), on the CPU and GPU backends.
 //! Inside intact rock contact costs nothing: with bonds declared, pairs glued together
 //! by intact joints (directly, around a shared vertex, or around a sealed element) skip
-//! the narrow phase until a joint near them breaks (see [`Contact`]).
+//! the narrow phase until a joint near them breaks (see [`Contact`]). On the CPU the
+//! sealed flags are re-derived only when the set of broken bonds changes, and the
+//! candidate lists' rebuild test watches only the nodes of unsealed elements.
 //!
 //! **Corrected equation.** The manual's friction law eq. 59, τ = P_t h |δ_s|, is not a
 //! stress and would make results depend on the unit system; the crate uses
