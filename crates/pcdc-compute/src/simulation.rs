@@ -582,6 +582,12 @@ impl<D: Dim> Simulation<D> {
         self.gpu.as_ref().map(|g| g.bytes_per_step())
     }
 
+    /// Whether the CPU step runs its node work in one fused pass: every composed physics
+    /// names the nodes its kinematic conditions write ([`Physics::kinematic_nodes`]).
+    pub fn fuses_node_passes(&self) -> bool {
+        self.kinematic_nodes.is_some()
+    }
+
     /// Labels of the GPU kernels in dispatch order (empty on the CPU backend).
     pub fn gpu_kernels(&self) -> Vec<String> {
         self.gpu

@@ -77,32 +77,28 @@ fn broken_faces(broken: &[f64]) -> Vec<u32> {
         .collect()
 }
 
-/// Whether the faces with a non-zero flag in `broken` are exactly `seen` (sorted). The
-/// scan runs in parallel over large blocks (a serial scan of every face would be a
-/// serial section of every step); each block lists its broken faces, an empty list
-/// allocating nothing, and the lists in order must equal `seen`.
+/// Whether the faces with a non-zero flag in `broken` are exactly `seen` (sorted,
+/// unique). Runs every step, so it is parallel (a serial scan of every face would be a
+/// serial section of the step) and allocates nothing: each block of faces compares its
+/// broken faces, in order, with its own segment of `seen` (found by binary search), and
+/// a block of zeros costs one vectorised test per `SCAN_BLOCK` faces.
 fn same_broken(seen: &[u32], broken: &[f64]) -> bool {
-    let lists: Vec<Vec<u32>> = broken
-        .par_chunks(SCAN_BLOCK * 64)
-        .enumerate()
-        .map(|(b, block)| {
-            let mut list = Vec::new();
-            for (c, chunk) in block.chunks(SCAN_BLOCK).enumerate() {
-                if !chunk.iter().fold(false, |any, &x| any | (x != 0.0)) {
-                    continue;
-                }
-                let first = b * SCAN_BLOCK * 64 + c * SCAN_BLOCK;
-                list.extend(
-                    (0..chunk.len())
+    const BLOCK: usize = SCAN_BLOCK * 64;
+    let in_range = seen.last().is_none_or(|&f| (f as usize) < broken.len());
+    in_range
+        && broken.par_chunks(BLOCK).enumerate().all(|(b, block)| {
+            let lo = b * BLOCK;
+            let start = seen.partition_point(|&f| (f as usize) < lo);
+            let end = seen.partition_point(|&f| (f as usize) < lo + block.len());
+            let mut expect = seen[start..end].iter();
+            let matches = block.chunks(SCAN_BLOCK).enumerate().all(|(c, chunk)| {
+                !chunk.iter().fold(false, |any, &x| any | (x != 0.0))
+                    || (0..chunk.len())
                         .filter(|&i| chunk[i] != 0.0)
-                        .map(|i| (first + i) as u32),
-                );
-            }
-            list
+                        .all(|i| expect.next() == Some(&((lo + c * SCAN_BLOCK + i) as u32)))
+            });
+            matches && expect.next().is_none()
         })
-        .collect();
-    lists.iter().map(Vec::len).sum::<usize>() == seen.len()
-        && lists.iter().flatten().eq(seen.iter())
 }
 
 #[cfg(test)]
