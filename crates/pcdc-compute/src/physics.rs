@@ -304,6 +304,7 @@ pub struct ForceContext<'a, D: Dim> {
 /// Which node velocities a physics' [`Physics::apply_kinematics`] writes
 /// ([`Physics::kinematic_nodes`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum KinematicNodes {
     /// None: the physics imposes no kinematic condition.
     None,
