@@ -67,6 +67,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .help("Measured steps"),
         )
         .arg(
+            Arg::new("warmup")
+                .long("warmup")
+                .value_parser(value_parser!(u64))
+                .default_value("20")
+                .help("Steps run before the measured ones (the loaded block's state evolves: joints near their peak take the damaged path)"),
+        )
+        .arg(
             Arg::new("threads")
                 .long("threads")
                 .value_parser(value_parser!(usize))
@@ -77,16 +84,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let contact = args.get_flag("contact");
     let steps = *args.get_one::<u64>("steps").expect("default");
     let threads = *args.get_one::<usize>("threads").expect("default");
+    let warmup = *args.get_one::<u64>("warmup").expect("default");
     let backend = Backend::cpu(threads)?;
     let what = if contact { "contact" } else { "joints" };
     if args.get_one::<String>("dim").map(String::as_str) == Some("3") {
         let cells = args.get_one::<usize>("cells").copied().unwrap_or(16);
         let sim = fdem_cuboid_3d(cells, backend, contact)?;
-        measure(sim, 20, steps, &format!("3D {what}, {threads} thread(s)"))?;
+        measure(
+            sim,
+            warmup,
+            steps,
+            &format!("3D {what}, {threads} thread(s)"),
+        )?;
     } else {
         let cells = args.get_one::<usize>("cells").copied().unwrap_or(112);
         let sim = fdem_block_2d(cells, backend, contact)?;
-        measure(sim, 20, steps, &format!("2D {what}, {threads} thread(s)"))?;
+        measure(
+            sim,
+            warmup,
+            steps,
+            &format!("2D {what}, {threads} thread(s)"),
+        )?;
     }
     Ok(())
 }

@@ -70,13 +70,26 @@ fn own_per_joint<D: Dim>(key: FieldKey, _n_joints: usize, components: Option<usi
     }
 }
 
-/// Where [`CohesiveJoints::joint`] writes joint `j`'s published kinematics.
-struct JointOut<'a> {
+/// Where [`CohesiveJoints::joint`] writes a joint's published kinematics (`V` = D
+/// components per vector).
+struct JointOut<'a, const V: usize> {
     /// Normal opening (m).
     opening: &'a mut f64,
-    /// Sliding vector (m), D components.
+    /// Sliding vector (m).
+    sliding: &'a mut [f64; V],
+    /// Unit normal.
+    normal: &'a mut [f64; V],
+}
+
+/// A block of consecutive joints' arrays (the slices of the per-joint fields that one
+/// task of the joint loop writes), starting at joint `first`.
+struct JointBlock<'a> {
+    first: usize,
+    slots: &'a mut [f64],
+    state: &'a mut [f64],
+    damage: &'a mut [f64],
+    opening: &'a mut [f64],
     sliding: &'a mut [f64],
-    /// Unit normal, D components.
     normal: &'a mut [f64],
 }
 
@@ -323,6 +336,64 @@ impl CohesiveJoints {
         src
     }
 
+    /// The joints of `block`: each one's kinematics, forces, state and damage
+    /// ([`CohesiveJoints::joint`]) with its model called by type. Iterating the arrays
+    /// together as fixed-size vectors leaves one bounds check per block instead of one
+    /// per slice per joint.
+    fn joint_block<D: Dim, const V: usize, const S: usize, const J: usize>(
+        &self,
+        block: JointBlock<'_>,
+        kin: &Kinematics<'_, D>,
+        coupling: &[f64],
+        cstride: usize,
+    ) {
+        let JointBlock {
+            first,
+            slots,
+            state,
+            damage,
+            opening,
+            sliding,
+            normal,
+        } = block;
+        let n = damage.len();
+        let nodes = &self.joints.nodes()[first * J..(first + n) * J];
+        let (model_of, hs) = (&self.model_of[first..first + n], &self.h[first..first + n]);
+        let per_joint = nodes
+            .chunks_exact(J)
+            .zip(slots.chunks_exact_mut(S))
+            .zip(state.chunks_exact_mut(self.state_stride()))
+            .zip(damage.iter_mut().zip(opening.iter_mut()))
+            .zip(sliding.chunks_exact_mut(V).zip(normal.chunks_exact_mut(V)))
+            .zip(model_of.iter().zip(hs));
+        for (i, (((((nd, sl), st), (dm, op)), (sd, nm)), (&mo, &h))) in per_joint.enumerate() {
+            let nd: &[u32; J] = nd.try_into().expect("chunks of J nodes");
+            let sl: &mut [f64; S] = sl.try_into().expect("chunks of S slot values");
+            let out: JointOut<'_, V> = JointOut {
+                opening: op,
+                sliding: sd.try_into().expect("chunks of V values"),
+                normal: nm.try_into().expect("chunks of V values"),
+            };
+            let cv: &[f64] = if cstride == 0 {
+                &[]
+            } else {
+                let j = first + i;
+                let len = self.coupling.len_of_model[mo as usize];
+                &coupling[j * cstride..j * cstride + len]
+            };
+            // A broken joint transfers no force; its kinematics are still published.
+            let broken = *dm >= 1.0;
+            let dmg = match &self.models[mo as usize] {
+                Model::Czm(m) => self.joint(nd, h, kin, sl, st, cv, out, broken, m),
+                Model::MohrCoulomb(m) => self.joint(nd, h, kin, sl, st, cv, out, broken, m),
+                Model::Plugin(m) => self.joint(nd, h, kin, sl, st, cv, out, broken, &**m),
+            };
+            if let Some(dmg) = dmg {
+                *dm = dmg;
+            }
+        }
+    }
+
     /// Joint `j`'s opening, sliding and normal into `out` and, unless it is `broken`
     /// (then its slots are zeroed and its damage returned unchanged as `None`), its
     /// forces into `slots` (2·NPF·D values), its state update and its damage; its
@@ -330,19 +401,19 @@ impl CohesiveJoints {
     /// joint's `coupling` values.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn joint<D: Dim, M: JointModel + ?Sized>(
+    fn joint<D: Dim, M: JointModel + ?Sized, const V: usize, const S: usize, const J: usize>(
         &self,
-        j: usize,
+        nodes: &[u32; J],
+        h: f64,
         kin: &Kinematics<'_, D>,
-        slots: &mut [f64],
+        slots: &mut [f64; S],
         state: &mut [f64],
         coupling: &[f64],
-        out: JointOut<'_>,
+        out: JointOut<'_, V>,
         broken: bool,
         model: &M,
     ) -> Option<f64> {
         let (d, npf) = (D::D, D::NODES_PER_FACE);
-        let nodes = self.joints.joint_nodes(j);
         let mut mid = [0.0; 9];
         let mut gap = [0.0; 9];
         for k in 0..npf {
@@ -389,7 +460,6 @@ impl CohesiveJoints {
         // by the area and written once, side B's the opposite (exact action-reaction).
         let mut fa = [0.0f64; 9];
         let ns = self.n_state;
-        let h = self.h[j];
         let mut damage = 0.0f64;
         // 2D: the kinematics in the joint's frame (n, t = (−n_y, n_x)), once per joint:
         // each node pair's normal and tangential gap; at a Gauss point the opening and
@@ -432,7 +502,12 @@ impl CohesiveJoints {
                 coupling,
             };
             let t = model.traction_with(&input, st);
-            damage = damage.max(model.damage(st));
+            // The largest damage (a comparison: f64::max's NaN handling costs more, and
+            // a NaN damage is ignored either way).
+            let dg = model.damage(st);
+            if dg > damage {
+                damage = dg;
+            }
             let mut tv = [0.0; 3];
             for c in 0..d {
                 tv[c] = t.normal * n[c] + t.shear[c];
@@ -690,35 +765,25 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
                 .zip(sliding.par_chunks_mut(CHUNK * d))
                 .zip(normal.par_chunks_mut(CHUNK * d))
                 .enumerate()
-                .for_each(|(c, (((((sl, st), dm), op), sd), nm))| {
-                    for i in 0..dm.len() {
-                        let j = c * CHUNK + i;
-                        let out = JointOut {
-                            opening: &mut op[i],
-                            sliding: &mut sd[i * d..(i + 1) * d],
-                            normal: &mut nm[i * d..(i + 1) * d],
+                .for_each(
+                    |(c, (((((slots, state), damage), opening), sliding), normal))| {
+                        let block = JointBlock {
+                            first: c * CHUNK,
+                            slots,
+                            state,
+                            damage,
+                            opening,
+                            sliding,
+                            normal,
                         };
-                        let cv: &[f64] = if cstride == 0 {
-                            &[]
-                        } else {
-                            let n = self.coupling.len_of_model[self.model_of[j] as usize];
-                            &cref[j * cstride..j * cstride + n]
-                        };
-                        // A broken joint transfers no force; its kinematics are still
-                        // published.
-                        let sl = &mut sl[i * 2 * npf * d..(i + 1) * 2 * npf * d];
-                        let st = &mut st[i * stride..(i + 1) * stride];
-                        let broken = dm[i] >= 1.0;
-                        let dmg = match &self.models[self.model_of[j] as usize] {
-                            Model::Czm(m) => self.joint(j, kin, sl, st, cv, out, broken, m),
-                            Model::MohrCoulomb(m) => self.joint(j, kin, sl, st, cv, out, broken, m),
-                            Model::Plugin(m) => self.joint(j, kin, sl, st, cv, out, broken, &**m),
-                        };
-                        if let Some(dmg) = dmg {
-                            dm[i] = dmg;
+                        // The per-joint arrays as fixed-size vectors: V = D components, S =
+                        // 2 NPF D slot values, J = 2 NPF nodes.
+                        match d {
+                            2 => self.joint_block::<D, 2, 8, 4>(block, kin, cref, cstride),
+                            _ => self.joint_block::<D, 3, 18, 6>(block, kin, cref, cstride),
                         }
-                    }
-                })
+                    },
+                )
         });
         self.coupling.values = cvalues;
         let [damage, broken] = ctx.fields.get_many_mut([did, bid]);

@@ -644,6 +644,32 @@ impl IntrinsicCzm {
         // Damage (eq. 68), irreversible. Before the peak in both modes nothing is
         // evaluated beyond comparisons: an undamaged joint pays no exp/pow.
         let mut d = state[DAMAGE];
+        let ts = self.params.tensile_strength;
+        if d == 0.0 && o <= op && slip <= sp && state[MAX_OPENING] <= op && state[MAX_SLIP] <= sp {
+            // Undamaged and never past either peak (the state of intact rock, and a
+            // branch that predicts well): the general path below with f = 1 and no
+            // unloading branch, the sign of the opening chosen by a select rather than a
+            // branch (in compressed rock it flips from point to point). Same operations,
+            // same bits.
+            // Written only when they grow, so the state of a steadily loaded joint
+            // stays clean in the cache (no write-back on the large meshes).
+            if o > state[MAX_OPENING] {
+                state[MAX_OPENING] = o;
+            }
+            if slip > state[MAX_SLIP] {
+                state[MAX_SLIP] = slip;
+            }
+            let overlap = self.params.penalty_overlap * o * inv_h;
+            let rise = rising(o * inv_op) * ts;
+            let normal = if o < 0.0 { overlap } else { rise };
+            let strength = (-normal * dv.tan_phi + self.params.cohesion).max(0.0);
+            let scale = (2.0 - slip * inv_sp) * strength * inv_sp;
+            let mut sv = [0.0; 3];
+            for (k, v) in slip_vec.iter().enumerate() {
+                sv[k] = scale * v;
+            }
+            return Traction { normal, shear: sv };
+        }
         if o > op || slip > sp {
             let dn = ((o - op) * dv.inv_ot).max(0.0);
             let ds = ((slip - sp) * dv.inv_st).max(0.0);
@@ -675,7 +701,6 @@ impl IntrinsicCzm {
         state[MAX_OPENING] = ou;
         state[MAX_SLIP] = su;
         // Normal traction (eq. 63, unloading eq. 72); 2 T_s / o_overlap = P_overlap / h.
-        let ts = self.params.tensile_strength;
         let normal = if o < 0.0 {
             self.params.penalty_overlap * o * inv_h
         } else if ou > op && o < ou {
