@@ -32,15 +32,16 @@ impl ActiveSet {
     /// Brings the vertex flags of `regions`, the sealed flags and the watched nodes up to
     /// date with `broken` (per face, non-zero once broken); without regions nothing is
     /// sealed. Bonds only break, but a restored snapshot may change them any way, so the
-    /// whole set of broken faces is compared, not a count.
+    /// whole set of broken faces is compared, not a count. Returns whether the set was
+    /// re-derived (always on the first call).
     pub fn refresh<D: Dim>(
         &mut self,
         regions: Option<&mut BondedRegions>,
         broken: &[f64],
         mesh: &Mesh<D>,
-    ) {
+    ) -> bool {
         if self.seen.as_deref().is_some_and(|s| same_broken(s, broken)) {
-            return;
+            return false;
         }
         let ne = mesh.n_elements();
         match regions {
@@ -66,6 +67,7 @@ impl ActiveSet {
         self.nodes.sort_unstable();
         self.nodes.dedup();
         self.seen = Some(broken_faces(broken));
+        true
     }
 }
 

@@ -5,11 +5,14 @@
 //! Every element keeps a candidate list of elements whose bounding boxes, inflated by
 //! the skin, overlap its own; the lists are rebuilt when any node has moved more than
 //! half the skin since the last build, and each list is sorted by element index, so
-//! the summation order does not depend on when a list was built. Each element walks its
-//! list, evaluates every pair in canonical order (lower index as contactor) and keeps
-//! the share of the pair force that lands on its own nodes: action equals reaction
-//! exactly and no atomics are needed. Elements sharing a node (one continuous body)
-//! do not contact each other.
+//! the summation order does not depend on when a list was built. On the CPU each pair
+//! is evaluated once, by its lower-index element (the contactor), which keeps its own
+//! share and hands the target's share to a second, ordered pass: element e's forces
+//! are its contactor shares in list order, then its target shares with contactors in
+//! ascending order, whatever the thread count. On the GPU (one invocation per element,
+//! no atomics) each element evaluates its pairs in the same canonical order and keeps
+//! the share that lands on its own nodes. Either way action equals reaction exactly.
+//! Elements sharing a node (one continuous body) do not contact each other.
 //!
 //! Per pair the physics keeps the law's history, carried across rebuilds and snapshots:
 //! for `contact-m-c` the accumulated slip δ_s of the friction law (eq. 59-60) and, with
@@ -31,8 +34,8 @@
 //!   the GPU setup checks), strictly increasing; entries from n on are 0;
 //! - [`CONTACT_HISTORY`] (per element, `capacity × s` values, s = the law's
 //!   [`ContactModel::n_state`], at least 1): the history of pair k at `k s .. (k + 1) s`,
-//!   in list order; both elements of a pair keep identical copies; entries from n s on
-//!   are 0.
+//!   in list order; both elements of a pair keep identical copies (the CPU updates the
+//!   contactor's and copies a change into the target's row); entries from n s on are 0.
 //!
 //! The capacity per element is fixed when the simulation is built ([`Contact::capacity`];
 //! default twice the largest list of the initial configuration, at least 48): a rebuild
@@ -290,6 +293,120 @@ pub struct Contact {
 #[derive(Debug, Default)]
 struct StepScratch {
     boxes: Vec<f64>,
+    /// Per block of elements, the target shares of the pairs its elements evaluated
+    /// (target element, forces), in evaluation order: kept between steps so that the
+    /// pair pass allocates nothing once warm.
+    shares2: Vec<Vec<(u32, [f64; 6])>>,
+    shares3: Vec<Vec<(u32, [f64; 12])>>,
+    /// Per block, the pair histories its contactors changed, to copy into the targets'
+    /// rows: (target, contactor, the `ns` values), flat.
+    mirrors: Vec<Vec<f64>>,
+}
+
+/// Elements per task of the pair pass (the unit of its deterministic order).
+const PAIR_BLOCK: usize = 256;
+
+/// The pair pass: every touching pair evaluated once, by its lower-index element (the
+/// contactor), and its two shares summed in a fixed order whatever the thread count.
+/// Element e's `S` slot values are zeroed, then receive the contactor shares of e's
+/// pairs with higher-index candidates (list order), then the target shares of the pairs
+/// whose contactor is a lower-index element (contactors in ascending order). `eval`
+/// returns a pair's (contactor, target) shares, or `None` when it exerts no force.
+/// Sealed elements are skipped; their slots are zeroed only when `zero_sealed` (the
+/// sealed set changed), as nothing else writes them.
+///
+/// A pair's history lives in both elements' rows (the GPU kernel, one invocation per
+/// element, evaluates each pair from both sides and keeps both copies in step): the
+/// contactor's copy is the one updated here, and a change is copied into the target's
+/// row afterwards, so that both copies stay equal and snapshots mean the same on both
+/// backends.
+#[allow(clippy::too_many_arguments)]
+fn pair_pass<'a, const S: usize, L, E>(
+    slots: &mut [f64],
+    hist: &mut [f64],
+    row: usize,
+    lists: &L,
+    sealed: &[bool],
+    zero_sealed: bool,
+    shares: &mut Vec<Vec<(u32, [f64; S])>>,
+    mirrors: &mut Vec<Vec<f64>>,
+    eval: &E,
+    stride: usize,
+    ns: usize,
+) where
+    L: Fn(usize) -> &'a [f64] + Sync,
+    E: Fn(usize, usize, &mut [f64]) -> Option<([f64; S], [f64; S])> + Sync,
+{
+    let ne = slots.len() / S;
+    let blocks = ne.div_ceil(PAIR_BLOCK);
+    shares.resize_with(blocks, Vec::new);
+    mirrors.resize_with(blocks, Vec::new);
+    slots
+        .par_chunks_mut(S * PAIR_BLOCK)
+        .zip(hist.par_chunks_mut(row * PAIR_BLOCK))
+        .zip(shares.par_iter_mut().zip(mirrors.par_iter_mut()))
+        .enumerate()
+        .for_each(|(b, ((slots, hist), (out, mirror)))| {
+            out.clear();
+            mirror.clear();
+            for (i, (slot, slip)) in slots
+                .chunks_exact_mut(S)
+                .zip(hist.chunks_exact_mut(row))
+                .enumerate()
+            {
+                let e = b * PAIR_BLOCK + i;
+                // Inside intact rock nothing can touch (see the `exclusion` module).
+                if sealed.get(e).copied().unwrap_or(false) {
+                    if zero_sealed {
+                        slot.fill(0.0);
+                    }
+                    continue;
+                }
+                slot.fill(0.0);
+                let list = lists(e);
+                // Lists are sorted: the higher-index candidates are a suffix.
+                let from = list.partition_point(|&f| f as usize <= e);
+                for (k, &f) in list.iter().enumerate().skip(from) {
+                    let state = &mut slip[k * stride..k * stride + ns];
+                    // The history before, kept only if the pair changes it.
+                    let mark = mirror.len();
+                    mirror.extend_from_slice(&[f, e as f64]);
+                    mirror.extend_from_slice(state);
+                    let force = eval(e, f as usize, state);
+                    if mirror[mark + 2..] == *state {
+                        mirror.truncate(mark);
+                    } else {
+                        mirror[mark + 2..].copy_from_slice(state);
+                    }
+                    if let Some((c, t)) = force {
+                        for (s, v) in slot.iter_mut().zip(c) {
+                            *s += v;
+                        }
+                        out.push((f as u32, t));
+                    }
+                }
+            }
+        });
+    // The target shares, contactors in ascending order (blocks in order, elements in
+    // order within a block). Serial, but one addition per touching pair.
+    for out in shares.iter() {
+        for (f, t) in out {
+            let f = *f as usize;
+            for (s, v) in slots[f * S..(f + 1) * S].iter_mut().zip(t) {
+                *s += v;
+            }
+        }
+    }
+    // The changed histories into the targets' rows (where the target lists the
+    // contactor: candidate lists are symmetric).
+    for m in mirrors.iter() {
+        for entry in m.chunks_exact(2 + ns) {
+            let (f, e) = (entry[0] as usize, entry[1]);
+            if let Ok(k) = lists(f).binary_search_by(|x| x.total_cmp(&e)) {
+                hist[f * row + k * stride..f * row + k * stride + ns].copy_from_slice(&entry[2..]);
+            }
+        }
+    }
 }
 
 /// Whether two boxes (lows then highs, `d` components each) are apart; touching counts
@@ -1171,7 +1288,8 @@ impl<D: Dim> Physics<D> for Contact {
         let broken: &[f64] = broken_id.map_or(&[], |b| ctx.fields.get(b));
         let active = &mut self.active;
         let regions = self.regions.as_mut();
-        ctx.backend
+        let refreshed = ctx
+            .backend
             .install(|| active.refresh(regions, broken, kin.mesh));
         // Rebuild when a node of an unsealed element moved more than half the skin since
         // the last build (a NaN reference, before the first build, always does).
@@ -1276,6 +1394,7 @@ impl<D: Dim> Physics<D> for Contact {
                     .and_then(|b| b.face(e, f))
                     .is_some_and(|face| broken[face] == 0.0)
         };
+        let row = cap * stride;
         if dim == 3 {
             // Tetrahedra: 4 nodes x 3 components of slots per element.
             let mean_edge3 = |e: usize| {
@@ -1289,46 +1408,39 @@ impl<D: Dim> Physics<D> for Contact {
                 }
                 sum / 6.0
             };
+            // Contactor c < target t.
+            let eval = |c: usize, t: usize, state: &mut [f64]| {
+                if skip(c, t, state) {
+                    return None;
+                }
+                let (xc, xt) = (Self::element_xyz(kin, c), Self::element_xyz(kin, t));
+                let mut pair = tet_pair_force(&xc, &xt, model.pair_penalty(c, t));
+                if pair == PairForce3::default() {
+                    // Not touching (most candidates): no force, fresh history.
+                    model.separate(state);
+                    return None;
+                }
+                let h = 0.5 * (mean_edge3(c) + mean_edge3(t));
+                apply_model3(&mut pair, kin, c, t, model, h, state);
+                Some((
+                    std::array::from_fn(|i| pair.contactor[i / 3][i % 3]),
+                    std::array::from_fn(|i| pair.target[i / 3][i % 3]),
+                ))
+            };
             ctx.backend.install(|| {
-                ctx.slots
-                    .par_chunks_mut(12)
-                    .zip(hist.par_chunks_mut(cap * stride))
-                    .enumerate()
-                    .for_each(|(e, (slot, slip))| {
-                        // Every slot written (`writes_all_slots`): zero, then the pairs.
-                        slot.fill(0.0);
-                        if sealed[e] {
-                            return;
-                        }
-                        let me = Self::element_xyz(kin, e);
-                        for (k, &f) in list(e).iter().enumerate() {
-                            let f = f as usize;
-                            let state = &mut slip[k * stride..k * stride + ns];
-                            if skip(e, f, state) {
-                                continue;
-                            }
-                            let other = Self::element_xyz(kin, f);
-                            let (c, t, ci, ti) = if e < f {
-                                (&me, &other, e, f)
-                            } else {
-                                (&other, &me, f, e)
-                            };
-                            let mut pair = tet_pair_force(c, t, model.pair_penalty(ci, ti));
-                            if pair == PairForce3::default() {
-                                // Not touching (most candidates): no force, fresh history.
-                                model.separate(state);
-                                continue;
-                            }
-                            let h = 0.5 * (mean_edge3(ci) + mean_edge3(ti));
-                            apply_model3(&mut pair, kin, ci, ti, model, h, state);
-                            let share = if e < f { pair.contactor } else { pair.target };
-                            for a in 0..4 {
-                                for d in 0..3 {
-                                    slot[3 * a + d] += share[a][d];
-                                }
-                            }
-                        }
-                    })
+                pair_pass::<12, _, _>(
+                    ctx.slots,
+                    hist,
+                    row,
+                    &list,
+                    sealed,
+                    refreshed,
+                    &mut scratch.shares3,
+                    &mut scratch.mirrors,
+                    &eval,
+                    stride,
+                    ns,
+                )
             });
             self.scratch = scratch;
             return Ok(());
@@ -1343,48 +1455,39 @@ impl<D: Dim> Physics<D> for Contact {
                 .sum::<f64>()
                 / 3.0
         };
+        // Contactor c < target t.
+        let eval = |c: usize, t: usize, state: &mut [f64]| {
+            if skip(c, t, state) {
+                return None;
+            }
+            let (xc, xt) = (Self::element_xy(kin, c), Self::element_xy(kin, t));
+            let mut pair = triangle_pair_force(&xc, &xt, model.pair_penalty(c, t));
+            if pair == PairForce2::default() {
+                // Not touching (most candidates): no force, fresh history.
+                model.separate(state);
+                return None;
+            }
+            let h = 0.5 * (mean_edge(c) + mean_edge(t));
+            apply_model(&mut pair, kin, c, t, model, h, state);
+            Some((
+                std::array::from_fn(|i| pair.contactor[i / 2][i % 2]),
+                std::array::from_fn(|i| pair.target[i / 2][i % 2]),
+            ))
+        };
         ctx.backend.install(|| {
-            ctx.slots
-                .par_chunks_mut(6)
-                .zip(hist.par_chunks_mut(cap * stride))
-                .enumerate()
-                .for_each(|(e, (slot, slip))| {
-                    // Every slot written (`writes_all_slots`): zero, then the pairs.
-                    slot.fill(0.0);
-                    // Inside intact rock nothing can touch (see the `exclusion` module).
-                    if sealed[e] {
-                        return;
-                    }
-                    let me = Self::element_xy(kin, e);
-                    for (k, &f) in list(e).iter().enumerate() {
-                        let f = f as usize;
-                        let state = &mut slip[k * stride..k * stride + ns];
-                        // Bonded neighbours interact through their joint until it breaks.
-                        if skip(e, f, state) {
-                            continue;
-                        }
-                        let other = Self::element_xy(kin, f);
-                        // Canonical order: the lower index is the contactor.
-                        let (c, t, ci, ti) = if e < f {
-                            (&me, &other, e, f)
-                        } else {
-                            (&other, &me, f, e)
-                        };
-                        let mut pair = triangle_pair_force(c, t, model.pair_penalty(ci, ti));
-                        if pair == PairForce2::default() {
-                            // Not touching (most candidates): no force, fresh history.
-                            model.separate(state);
-                            continue;
-                        }
-                        let h = 0.5 * (mean_edge(ci) + mean_edge(ti));
-                        apply_model(&mut pair, kin, ci, ti, model, h, state);
-                        let share = if e < f { pair.contactor } else { pair.target };
-                        for a in 0..3 {
-                            slot[2 * a] += share[a][0];
-                            slot[2 * a + 1] += share[a][1];
-                        }
-                    }
-                })
+            pair_pass::<6, _, _>(
+                ctx.slots,
+                hist,
+                row,
+                &list,
+                sealed,
+                refreshed,
+                &mut scratch.shares2,
+                &mut scratch.mirrors,
+                &eval,
+                stride,
+                ns,
+            )
         });
         self.scratch = scratch;
         Ok(())
