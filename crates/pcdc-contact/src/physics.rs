@@ -306,6 +306,9 @@ struct StepScratch {
 /// Elements per task of the pair pass (the unit of its deterministic order).
 const PAIR_BLOCK: usize = 256;
 
+/// Pair histories up to this many values are compared on the stack.
+const SMALL_HISTORY: usize = 4;
+
 /// The pair pass: every touching pair evaluated once, by its lower-index element (the
 /// contactor), and its two shares summed in a fixed order whatever the thread count.
 /// Element e's `S` slot values are zeroed, then receive the contactor shares of e's
@@ -368,15 +371,32 @@ fn pair_pass<'a, const S: usize, L, E>(
                 let from = list.partition_point(|&f| f as usize <= e);
                 for (k, &f) in list.iter().enumerate().skip(from) {
                     let state = &mut slip[k * stride..k * stride + ns];
-                    // The history before, kept only if the pair changes it.
+                    // The history before (on the stack for the usual few values), to
+                    // record it only if the pair changes it.
+                    // (Element-wise loops: a run-time length would call memcpy.)
                     let mark = mirror.len();
-                    mirror.extend_from_slice(&[f, e as f64]);
-                    mirror.extend_from_slice(state);
-                    let force = eval(e, f as usize, state);
-                    if mirror[mark + 2..] == *state {
-                        mirror.truncate(mark);
+                    let mut before = [0.0; SMALL_HISTORY];
+                    if ns <= SMALL_HISTORY {
+                        for (b, &x) in before.iter_mut().zip(&*state) {
+                            *b = x;
+                        }
                     } else {
-                        mirror[mark + 2..].copy_from_slice(state);
+                        mirror.extend_from_slice(state);
+                    }
+                    let force = eval(e, f as usize, state);
+                    let same = if ns <= SMALL_HISTORY {
+                        before.iter().zip(&*state).all(|(b, x)| b == x)
+                    } else {
+                        let same = mirror[mark..].iter().zip(&*state).all(|(b, x)| b == x);
+                        mirror.truncate(mark);
+                        same
+                    };
+                    if !same {
+                        mirror.push(f);
+                        mirror.push(e as f64);
+                        for &x in &*state {
+                            mirror.push(x);
+                        }
                     }
                     if let Some((c, t)) = force {
                         for (s, v) in slot.iter_mut().zip(c) {
