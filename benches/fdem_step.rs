@@ -14,6 +14,12 @@
 //! (Mesa's lavapipe) only the 10k mesh runs, and its rows prove that the path works, not
 //! GPU speed.
 //!
+//! CPU rows: one iteration is `run(CPU_STEPS)` (the rate of steps inside a run, as
+//! the examples and most scenes advance). Rows `..._step_calls` call `step()` once per
+//! iteration instead: each call hands the step to the backend's pool and back, and on
+//! an unpinned 2-core VM the pool's worker then changes core from step to step, so
+//! these rows show what that costs (docs/performance.md).
+//!
 //! Run: `cargo bench --bench fdem_step`. Criterion reports elements/s = triangle-steps/s;
 //! joint-steps/s = triangle-steps/s x joints/triangles (about 1.5), printed once per mesh.
 //!
@@ -31,6 +37,9 @@ use pcdc_validation::scenes::benchmark::{fdem_block_2d, fdem_cuboid_3d};
 
 /// Steps per measured GPU iteration.
 const GPU_STEPS: u64 = 20;
+
+/// Steps per measured CPU iteration.
+const CPU_STEPS: u64 = 10;
 
 fn scene(cells_x: usize, backend: Backend) -> Simulation<Dim2> {
     scene_with(cells_x, backend, false)
@@ -60,10 +69,16 @@ fn bench(c: &mut Criterion) {
                 let joints = sim.field(pcdc_cohesive::JOINT_DAMAGE).unwrap().len();
                 eprintln!("fdem_step: {n} triangles, {joints} joints ({:.3} joints per triangle), {:.0} B per triangle in the simulation state", joints as f64 / n as f64, sim.state_bytes() as f64 / n as f64);
             }
-            g.throughput(Throughput::Elements(n as u64));
+            g.throughput(Throughput::Elements(n as u64 * CPU_STEPS));
             g.bench_function(format!("tri3_{}k_joints_threads_{t}", n / 1000), |b| {
-                b.iter(|| sim.step().unwrap())
+                b.iter(|| sim.run(CPU_STEPS).unwrap())
             });
+            if nx == 50 && t == 1 {
+                g.throughput(Throughput::Elements(n as u64));
+                g.bench_function("tri3_10k_joints_threads_1_step_calls", |b| {
+                    b.iter(|| sim.step().unwrap())
+                });
+            }
         }
     }
     // The full scene with contact (CPU).
@@ -88,10 +103,16 @@ fn bench(c: &mut Criterion) {
                     sim.state_bytes() as f64 / n as f64
                 );
             }
-            g.throughput(Throughput::Elements(n as u64));
+            g.throughput(Throughput::Elements(n as u64 * CPU_STEPS));
             g.bench_function(format!("tri3_{}k_contact_threads_{t}", n / 1000), |b| {
-                b.iter(|| sim.step().unwrap())
+                b.iter(|| sim.run(CPU_STEPS).unwrap())
             });
+            if nx == 50 && t == 1 {
+                g.throughput(Throughput::Elements(n as u64));
+                g.bench_function("tri3_10k_contact_threads_1_step_calls", |b| {
+                    b.iter(|| sim.step().unwrap())
+                });
+            }
         }
     }
     // The 3D scene (tetrahedra, joints on every interior face, with and without contact).
@@ -105,9 +126,9 @@ fn bench(c: &mut Criterion) {
                     let joints = sim.field(pcdc_cohesive::JOINT_DAMAGE).unwrap().len();
                     eprintln!("fdem_step 3D {what}: {n} tetrahedra, {joints} joints ({:.3} per tetrahedron), {:.0} B per tetrahedron in the simulation state", joints as f64 / n as f64, sim.state_bytes() as f64 / n as f64);
                 }
-                g.throughput(Throughput::Elements(n as u64));
+                g.throughput(Throughput::Elements(n as u64 * CPU_STEPS));
                 g.bench_function(format!("tet4_{}k_{what}_threads_{t}", n / 1000), |b| {
-                    b.iter(|| sim.step().unwrap())
+                    b.iter(|| sim.run(CPU_STEPS).unwrap())
                 });
             }
         }

@@ -19,6 +19,7 @@ fn measure<D: Dim>(
     mut sim: Simulation<D>,
     warmup: u64,
     steps: u64,
+    single: bool,
     label: &str,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let n = sim.mesh().n_elements();
@@ -26,7 +27,15 @@ fn measure<D: Dim>(
     sim.run(warmup)?;
     let warm = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    sim.run(steps)?;
+    if single {
+        // As criterion's `b.iter(|| sim.step())`: one call per step, each handing the
+        // step to the backend's pool and back.
+        for _ in 0..steps {
+            sim.step()?;
+        }
+    } else {
+        sim.run(steps)?;
+    }
     let wall = t1.elapsed().as_secs_f64();
     println!(
         "{label}: {n} elements, {steps} steps in {wall:.3} s = {:.3} M element-steps/s ({:.1} ns per element-step); warm-up {warmup} steps {warm:.3} s; state {:.0} B per element",
@@ -74,6 +83,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .help("Steps run before the measured ones (the loaded block's state evolves: joints near their peak take the damaged path)"),
         )
         .arg(
+            Arg::new("single-steps")
+                .long("single-steps")
+                .action(ArgAction::SetTrue)
+                .help("Call `step()` once per step, as the criterion bench does, instead of one `run(steps)`"),
+        )
+        .arg(
             Arg::new("threads")
                 .long("threads")
                 .value_parser(value_parser!(usize))
@@ -85,6 +100,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let steps = *args.get_one::<u64>("steps").expect("default");
     let threads = *args.get_one::<usize>("threads").expect("default");
     let warmup = *args.get_one::<u64>("warmup").expect("default");
+    let single = args.get_flag("single-steps");
     let backend = Backend::cpu(threads)?;
     let what = if contact { "contact" } else { "joints" };
     if args.get_one::<String>("dim").map(String::as_str) == Some("3") {
@@ -94,6 +110,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             sim,
             warmup,
             steps,
+            single,
             &format!("3D {what}, {threads} thread(s)"),
         )?;
     } else {
@@ -103,6 +120,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             sim,
             warmup,
             steps,
+            single,
             &format!("2D {what}, {threads} thread(s)"),
         )?;
     }
