@@ -44,6 +44,7 @@ mod active;
 mod exclusion;
 mod gpu;
 mod model;
+mod pair_pass;
 mod physics;
 mod potential2d;
 mod potential3d;
