@@ -228,16 +228,6 @@ pub(crate) fn setup<D: Dim>(
         ))
         .bind("flag", flag, Access::ReadWrite)
     };
-    // The Gauss points of the 2D edge integrals (the 3D face integrals use edge
-    // midpoints).
-    let gauss = |k: Kernel| {
-        if D::D == 2 {
-            k.const_real("GAUSS_0", 0.5 - 0.5 / 3f64.sqrt())
-                .const_real("GAUSS_1", 0.5 + 0.5 / 3f64.sqrt())
-        } else {
-            k
-        }
-    };
     // Kernels that locate box centres on the grid (they bind `boxes`).
     let cells = |label: &str, body: &str, n: usize| broad(label, &format!("{CELLS}{body}"), n);
     let mut kernels = vec![
@@ -303,28 +293,26 @@ pub(crate) fn setup<D: Dim>(
         .bind("coords", setup.coords(), Access::Read)
         .bind("disp", setup.displacement(), Access::Read)
         .bind("reference", reference, Access::ReadWrite),
-        gauss(
-            common(Kernel::new("contact forces", forces_source, ne))
-                .const_u32("SLOT_FIRST", setup.slot_first())
-                .const_u32("MODEL_KIND", splice.kinds[0])
-                .const_u32("MODEL_AT", 0)
-                .const_real("PENALTY", model.normal_penalty())
-                .const_u32("REGIONS", regions as u32),
-        )
-        .bind("coords", setup.coords(), Access::Read)
-        .bind("disp", setup.displacement(), Access::Read)
-        .bind("vel", setup.velocity(), Access::Read)
-        .bind("conn", conn, Access::Read)
-        .bind("cand", cand, Access::Read)
-        .bind("ncand", ncand, Access::Read)
-        .bind("hist", hist, Access::ReadWrite)
-        .bind("bond_ptr", bond_ptr, Access::Read)
-        .bind("bond_list", bond_list, Access::Read)
-        .bind("broken", broken, Access::Read)
-        .bind("model_data", model_data, Access::Read)
-        .bind("elem_vertex", elem_vertex, Access::Read)
-        .bind("vertex_flags", vertex_flags, Access::Read)
-        .bind("slots", setup.slots(), Access::ReadWrite),
+        common(Kernel::new("contact forces", forces_source, ne))
+            .const_u32("SLOT_FIRST", setup.slot_first())
+            .const_u32("MODEL_KIND", splice.kinds[0])
+            .const_u32("MODEL_AT", 0)
+            .const_real("PENALTY", model.normal_penalty())
+            .const_u32("REGIONS", regions as u32)
+            .bind("coords", setup.coords(), Access::Read)
+            .bind("disp", setup.displacement(), Access::Read)
+            .bind("vel", setup.velocity(), Access::Read)
+            .bind("conn", conn, Access::Read)
+            .bind("cand", cand, Access::Read)
+            .bind("ncand", ncand, Access::Read)
+            .bind("hist", hist, Access::ReadWrite)
+            .bind("bond_ptr", bond_ptr, Access::Read)
+            .bind("bond_list", bond_list, Access::Read)
+            .bind("broken", broken, Access::Read)
+            .bind("model_data", model_data, Access::Read)
+            .bind("elem_vertex", elem_vertex, Access::Read)
+            .bind("vertex_flags", vertex_flags, Access::Read)
+            .bind("slots", setup.slots(), Access::ReadWrite),
     ];
     if let Some(r) = input.regions.filter(|_| regions) {
         // The vertex flags, after the joints and before the forces.
