@@ -150,6 +150,92 @@ pub struct Friction {
     pub penalty: f64,
 }
 
+impl MohrCoulombContact {
+    /// [`ContactModel::update`] with tan φ given (`tan_phi`, unused without friction).
+    #[inline]
+    fn update_with(
+        &self,
+        tan_phi: f64,
+        s_try: f64,
+        dslip: f64,
+        h: f64,
+        state: &mut [f64],
+    ) -> ContactStress {
+        let normal = match self.damping {
+            None => s_try,
+            Some(d) => {
+                if s_try >= state[1] {
+                    state[1] = s_try;
+                    state[2] = s_try.min(d.transition);
+                    state[2]
+                } else {
+                    state[2] * damping_power(s_try / state[1], d.exponent)
+                }
+            }
+        };
+        let mut shear = 0.0;
+        if let Some(fr) = self.friction {
+            // eq. 59 (corrected, see [`Friction`]): τ = P_t |δ_s| / h up to tan φ σ_n;
+            // eq. 60: δ_s reset to the limit.
+            state[0] += dslip;
+            let kt = fr.penalty / h;
+            let limit = tan_phi * normal;
+            let mut t = kt * state[0].abs();
+            if t > limit {
+                t = limit;
+                state[0] = state[0].signum() * limit / kt;
+            }
+            shear = -state[0].signum() * t;
+        }
+        ContactStress { normal, shear }
+    }
+}
+
+/// The built-in law as the contact physics runs it: [`MohrCoulombContact`] with tan φ
+/// taken once, not per touching pair (the same value, so the same bits). Its `Debug` is
+/// the law's own, so snapshot fingerprints do not change.
+pub(crate) struct CachedMohrCoulomb {
+    law: MohrCoulombContact,
+    tan_phi: f64,
+}
+
+impl CachedMohrCoulomb {
+    pub(crate) fn new(law: MohrCoulombContact) -> Self {
+        let tan_phi = law.friction.map_or(0.0, |f| f.angle_deg.to_radians().tan());
+        CachedMohrCoulomb { law, tan_phi }
+    }
+}
+
+impl Debug for CachedMohrCoulomb {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.law.fmt(f)
+    }
+}
+
+impl ContactModel for CachedMohrCoulomb {
+    fn name(&self) -> &str {
+        self.law.name()
+    }
+    fn normal_penalty(&self) -> f64 {
+        self.law.normal_penalty()
+    }
+    fn shear_penalty(&self) -> f64 {
+        self.law.shear_penalty()
+    }
+    fn n_state(&self) -> usize {
+        self.law.n_state()
+    }
+    fn check(&self) -> Result<(), ComputeError> {
+        self.law.check()
+    }
+    fn update(&self, s_try: f64, dslip: f64, h: f64, state: &mut [f64]) -> ContactStress {
+        self.law.update_with(self.tan_phi, s_try, dslip, h, state)
+    }
+    fn wgsl(&self) -> Option<WgslContactModel> {
+        self.law.wgsl()
+    }
+}
+
 /// Contact damping after An and Tannant (2007), manual eq. 61.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactDamping {
@@ -244,33 +330,10 @@ impl ContactModel for MohrCoulombContact {
         Ok(())
     }
     fn update(&self, s_try: f64, dslip: f64, h: f64, state: &mut [f64]) -> ContactStress {
-        let normal = match self.damping {
-            None => s_try,
-            Some(d) => {
-                if s_try >= state[1] {
-                    state[1] = s_try;
-                    state[2] = s_try.min(d.transition);
-                    state[2]
-                } else {
-                    state[2] * damping_power(s_try / state[1], d.exponent)
-                }
-            }
-        };
-        let mut shear = 0.0;
-        if let Some(fr) = self.friction {
-            // eq. 59 (corrected, see [`Friction`]): τ = P_t |δ_s| / h up to tan φ σ_n;
-            // eq. 60: δ_s reset to the limit.
-            state[0] += dslip;
-            let kt = fr.penalty / h;
-            let limit = fr.angle_deg.to_radians().tan() * normal;
-            let mut t = kt * state[0].abs();
-            if t > limit {
-                t = limit;
-                state[0] = state[0].signum() * limit / kt;
-            }
-            shear = -state[0].signum() * t;
-        }
-        ContactStress { normal, shear }
+        let tan_phi = self
+            .friction
+            .map_or(0.0, |f| f.angle_deg.to_radians().tan());
+        self.update_with(tan_phi, s_try, dslip, h, state)
     }
     fn wgsl(&self) -> Option<WgslContactModel> {
         let (fr_on, tan_phi, pt) = match self.friction {

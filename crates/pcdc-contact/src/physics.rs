@@ -83,7 +83,7 @@ use std::sync::Arc;
 
 use crate::active::ActiveSet;
 use crate::exclusion::BondedRegions;
-use crate::model::{ContactDamping, ContactModel, Friction, MohrCoulombContact};
+use crate::model::{CachedMohrCoulomb, ContactDamping, ContactModel, Friction, MohrCoulombContact};
 use crate::pair_pass::{boxes_apart, pair_pass};
 use crate::{tet_pair_force, triangle_pair_force, PairForce2, PairForce3};
 
@@ -470,11 +470,11 @@ impl Contact {
     fn law(&self) -> Arc<dyn ContactModel> {
         match &self.custom {
             Some(m) => m.clone(),
-            None => Arc::new(MohrCoulombContact {
+            None => Arc::new(CachedMohrCoulomb::new(MohrCoulombContact {
                 normal_penalty: self.penalty,
                 friction: self.friction,
                 damping: self.damping,
-            }),
+            })),
         }
     }
 
