@@ -40,11 +40,8 @@ use pcdc_compute::{Components, FieldKey, Place};
 /// Joint history, `NGAUSS × n_state` values per joint (model state per Gauss point).
 pub const JOINT_STATE: FieldKey =
     FieldKey::new("joint_state", Place::Set(JOINTS), Components::Declared);
-/// Largest damage D over the joint's Gauss points (1 value per joint; 1 = broken).
-pub const JOINT_DAMAGE: FieldKey =
-    FieldKey::new("joint_damage", Place::Set(JOINTS), Components::Fixed(1));
 /// Face field: 1 on both faces of a broken joint, else 0 (what contact reads).
 pub const BROKEN_FACE: FieldKey = FieldKey::new("broken_face", Place::Face, Components::Fixed(1));
-// The joint kinematics are read by physics that must not depend on this crate (fluid
+// The joint kinematics and damage are read by physics that must not depend on this crate (fluid
 // flow, bolts): their keys are the shared ones of pcdc-compute.
-pub use pcdc_compute::names::{JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING};
+pub use pcdc_compute::names::{JOINT_DAMAGE, JOINT_NORMAL, JOINT_OPENING, JOINT_SLIDING};

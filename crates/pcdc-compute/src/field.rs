@@ -52,6 +52,11 @@ pub mod names {
     /// Owner: cohesive joints.
     pub const JOINT_NORMAL: FieldKey =
         FieldKey::new("joint_normal", Place::Set(JOINTS), Components::Vector);
+    /// Largest damage D over each joint's integration points (1 value per joint; 1 =
+    /// broken), as the joints publish it: fluid flow starts leak-off when a joint breaks,
+    /// bolts may read it. Owner: cohesive joints.
+    pub const JOINT_DAMAGE: FieldKey =
+        FieldKey::new("joint_damage", Place::Set(JOINTS), Components::Fixed(1));
     /// Node temperature T (K), one value per node. Owner: the thermal physics (the
     /// future `pcdc-thermal`). Constitutive and joint models read it as a coupling
     /// input (e.g. thermal strain α ΔT).

@@ -500,10 +500,16 @@ pub fn offline_kernel_sources<D: Dim>(
     let program =
         crate::gpu::run::build_program(mesh, &mut physics, &layout.fields, &layout, precision)?;
     let mut out = Vec::new();
-    for (_, k) in &program.kernels {
+    for (phase, k) in &program.kernels {
+        // Field kernels get their sub-cycling scale from the schedule, as in a run.
+        let k = if *phase == Phase::Field {
+            k.clone().const_real("FIELD_DT_SCALE", 1.0)
+        } else {
+            k.clone()
+        };
         out.push((
             k.label.clone(),
-            assemble(k, precision, &|b| program.elem_of(b)),
+            assemble(&k, precision, &|b| program.elem_of(b)),
         ));
     }
     for k in crate::gpu::run::builtin_kernels::<D>(layout.coords.len() / D::D) {
