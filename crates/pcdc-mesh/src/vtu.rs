@@ -201,6 +201,49 @@ pub fn write_vtu_with<D: Dim>(
     w.flush().map_err(io_err)
 }
 
+/// Cells other than a mesh's elements, for [`write_cells_vtu`]: e.g. the line (2D) or
+/// triangle (3D) channels of a flow network, or bolt segments.
+#[derive(Clone, Copy, Debug)]
+pub struct Cells<'a> {
+    /// Point coordinates (m), stride `D`.
+    pub points: &'a [f64],
+    /// Point indices of every cell, stride `nodes_per_cell`.
+    pub connectivity: &'a [u32],
+    /// Points per cell.
+    pub nodes_per_cell: usize,
+    /// The VTK cell type ([`VTK_LINE`], [`VTK_TRIANGLE`], ...).
+    pub cell_type: u8,
+}
+
+/// VTK cell type of a two-point line.
+pub const VTK_LINE: u8 = 3;
+/// VTK cell type of a three-point triangle.
+pub const VTK_TRIANGLE: u8 = 5;
+
+/// Writes `cells` as a VTK XML UnstructuredGrid (raw appended binary), with point data
+/// (one tuple per point) and cell data (one per cell), validated as in [`write_vtu`]
+/// (plus: the connectivity must fit the points).
+pub fn write_cells_vtu<D: Dim>(
+    path: impl AsRef<Path>,
+    cells: &Cells,
+    point_data: &[DataArray],
+    cell_data: &[DataArray],
+    encoding: VtuEncoding,
+) -> Result<(), MeshError> {
+    let path = path.as_ref();
+    let io_err = |source| MeshError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let n_points = cells.points.len() / D::D;
+    let grid = Grid::of_cells::<D>(cells, n_points, point_data, cell_data, ("points", "cells"))
+        .map_err(io_err)?;
+    let file = File::create(path).map_err(io_err)?;
+    let mut w = BufWriter::new(file);
+    grid.write(&mut w, encoding).map_err(io_err)?;
+    w.flush().map_err(io_err)
+}
+
 /// A `.pvd` time series: one `.vtu` file per step in a directory, listed with its time in
 /// a `.pvd` collection file that ParaView opens as one time-dependent data set.
 ///
@@ -293,6 +336,29 @@ impl PvdSeries {
             });
         }
         write_vtu_with(&path, mesh, points, point_data, cell_data, self.encoding)?;
+        self.steps.push((time, file_name));
+        self.write_pvd()?;
+        Ok(path)
+    }
+
+    /// Writes the next step of [`Cells`] ([`write_cells_vtu`]) and updates the `.pvd`
+    /// file, like [`PvdSeries::write_step`].
+    pub fn write_cells_step<D: Dim>(
+        &mut self,
+        time: f64,
+        cells: &Cells,
+        point_data: &[DataArray],
+        cell_data: &[DataArray],
+    ) -> Result<PathBuf, MeshError> {
+        let file_name = format!("{}_{:06}.vtu", self.base_name, self.steps.len());
+        let path = self.dir.join(&file_name);
+        if !time.is_finite() {
+            return Err(MeshError::Io {
+                path: path.display().to_string(),
+                source: invalid(format!("time {time} is not finite")),
+            });
+        }
+        write_cells_vtu::<D>(&path, cells, point_data, cell_data, self.encoding)?;
         self.steps.push((time, file_name));
         self.write_pvd()?;
         Ok(path)
@@ -492,14 +558,48 @@ impl<'a> Grid<'a> {
         point_data: &[DataArray<'a>],
         cell_data: &[DataArray<'a>],
     ) -> io::Result<Self> {
-        let (d, npe) = (D::D, D::NODES_PER_ELEM);
-        let (n_points, n_cells) = (mesh.n_nodes(), mesh.n_elements());
-        let coords = points.unwrap_or(mesh.coords());
+        let cells = Cells {
+            points: points.unwrap_or(mesh.coords()),
+            connectivity: mesh.elements(),
+            nodes_per_cell: D::NODES_PER_ELEM,
+            cell_type: D::ELEMENT.vtk_cell_type(),
+        };
+        Self::of_cells::<D>(
+            &cells,
+            mesh.n_nodes(),
+            point_data,
+            cell_data,
+            ("nodes", "elements"),
+        )
+    }
+
+    /// `n_points`: the points expected in `cells.points` (stride D).
+    fn of_cells<D: Dim>(
+        cells: &Cells<'a>,
+        n_points: usize,
+        point_data: &[DataArray<'a>],
+        cell_data: &[DataArray<'a>],
+        (point_kind, cell_kind): (&str, &str),
+    ) -> io::Result<Self> {
+        let (d, npe) = (D::D, cells.nodes_per_cell);
+        let coords = cells.points;
         if coords.len() != n_points * d {
             return Err(invalid(format!(
-                "points array has {} values, expected {} ({n_points} nodes x {d} coordinates)",
+                "points array has {} values, expected {} ({n_points} {point_kind} x {d} coordinates)",
                 coords.len(),
                 n_points * d
+            )));
+        }
+        if npe == 0 || cells.connectivity.len() % npe != 0 {
+            return Err(invalid(format!(
+                "connectivity has {} entries, not a multiple of {npe} nodes per cell",
+                cells.connectivity.len()
+            )));
+        }
+        let n_cells = cells.connectivity.len() / npe;
+        if let Some(bad) = cells.connectivity.iter().find(|&&n| n as usize >= n_points) {
+            return Err(invalid(format!(
+                "connectivity refers to point {bad}, but there are {n_points} points"
             )));
         }
         let geometry = vec![
@@ -515,7 +615,7 @@ impl<'a> Grid<'a> {
                 ncomp: npe,
                 write_ncomp: false,
                 n_tuples: n_cells,
-                source: Source::Connectivity(mesh.elements()),
+                source: Source::Connectivity(cells.connectivity),
             },
             OutArray {
                 name: "offsets",
@@ -529,14 +629,14 @@ impl<'a> Grid<'a> {
                 ncomp: 1,
                 write_ncomp: false,
                 n_tuples: n_cells,
-                source: Source::Types(D::ELEMENT.vtk_cell_type()),
+                source: Source::Types(cells.cell_type),
             },
         ];
         Ok(Grid {
             n_points,
             n_cells,
-            point_data: out_arrays::<D>("point", "nodes", point_data, n_points)?,
-            cell_data: out_arrays::<D>("cell", "elements", cell_data, n_cells)?,
+            point_data: out_arrays::<D>("point", point_kind, point_data, n_points)?,
+            cell_data: out_arrays::<D>("cell", cell_kind, cell_data, n_cells)?,
             geometry,
         })
     }
@@ -701,6 +801,59 @@ mod tests {
             .unwrap_or_else(|| panic!("no {attr} in {elem}"))
             + key.len();
         elem[a..a + elem[a..].find('"').unwrap()].to_string()
+    }
+
+    #[test]
+    fn line_cells_with_their_data() {
+        let dir = tmp_dir("cells");
+        let path = dir.join("net.vtu");
+        let points = [0.0, 0.0, 1.0, 0.0, 1.0, 1.0];
+        let cells = Cells {
+            points: &points,
+            connectivity: &[0, 1, 1, 2],
+            nodes_per_cell: 2,
+            cell_type: VTK_LINE,
+        };
+        let p = [1.0, 2.0, 3.0];
+        let a = [1e-4, 2e-4];
+        write_cells_vtu::<Dim2>(
+            &path,
+            &cells,
+            &[DataArray::Scalar {
+                name: "pressure",
+                values: &p,
+            }],
+            &[DataArray::Scalar {
+                name: "aperture",
+                values: &a,
+            }],
+            VtuEncoding::Ascii,
+        )
+        .unwrap();
+        let xml = std::fs::read_to_string(&path).unwrap();
+        assert!(xml.contains("NumberOfPoints=\"3\" NumberOfCells=\"2\""));
+        assert_eq!(ascii_array(&xml, "types"), vec![3.0, 3.0]);
+        assert_eq!(ascii_array(&xml, "connectivity"), vec![0.0, 1.0, 1.0, 2.0]);
+        assert_eq!(ascii_array(&xml, "aperture"), a.to_vec());
+        // A cell beyond the points, or data of the wrong length, is refused by name.
+        let bad = Cells {
+            connectivity: &[0, 3],
+            ..cells
+        };
+        let e = write_cells_vtu::<Dim2>(&path, &bad, &[], &[], VtuEncoding::Ascii).unwrap_err();
+        assert!(e.to_string().contains("point 3"), "{e}");
+        let e = write_cells_vtu::<Dim2>(
+            &path,
+            &cells,
+            &[],
+            &[DataArray::Scalar {
+                name: "aperture",
+                values: &p,
+            }],
+            VtuEncoding::Ascii,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("aperture"), "{e}");
     }
 
     fn find(hay: &[u8], needle: &[u8]) -> usize {
