@@ -1,0 +1,124 @@
+//! Flow-only runs against closed forms and the mass balance.
+
+use pcdc_compute::{Backend, Simulation, SubCycle};
+use pcdc_hydro::fields::{FLOW_PRESSURE, FLOW_SATURATION};
+use pcdc_hydro::{mass_balance, Aperture, Coupling, FlowModel, Fluid, Hydro};
+use pcdc_mesh::{builders, split_nodes, Dim2, Range};
+
+/// Carslaw & Jaeger (manual eq. 91–92 corrected): p held at x = 0, no flow at x = L,
+/// p = 0 at t = 0; T = D t / L², ξ = 1 − x/L.
+fn fracture_closed_form(p_a: f64, x: f64, l: f64, t_dimless: f64) -> f64 {
+    let xi = 1.0 - x / l;
+    let mut sum = 0.0;
+    for n in 0..200 {
+        let m = (2 * n + 1) as f64;
+        let sign = if n % 2 == 0 { -1.0 } else { 1.0 };
+        sum += sign / m
+            * (-m * m * std::f64::consts::PI.powi(2) * t_dimless / 4.0).exp()
+            * (m * std::f64::consts::PI * xi / 2.0).cos();
+    }
+    p_a * (1.0 + 4.0 / std::f64::consts::PI * sum)
+}
+
+/// The flow node nearest to `x` along the fracture y = 0.
+fn node_at(sim: &Simulation<Dim2>, x: f64) -> usize {
+    let set = sim.entity_set(pcdc_hydro::fields::FLOW_NODES).unwrap();
+    let mesh = sim.mesh();
+    (0..set.len())
+        .min_by(|&a, &b| {
+            let da = (mesh.node(set.entity(a)[0] as usize)[0] - x).abs();
+            let db = (mesh.node(set.entity(b)[0] as usize)[0] - x).abs();
+            da.total_cmp(&db)
+        })
+        .unwrap()
+}
+
+#[test]
+fn transient_flow_along_one_fracture_matches_the_closed_form() {
+    let (l, h, delta, p_a) = (1.0, 0.05, 1e-4, 1e6);
+    let mesh = split_nodes(
+        &builders::rectangle(0.0, -0.1, l, 0.2, h).unwrap(),
+        &Range::All,
+    )
+    .unwrap();
+    let fluid = Fluid::water();
+    let model = FlowModel::new(fluid, Aperture::fixed(delta).unwrap());
+    let flow = Hydro::new(model)
+        .coupling(Coupling::FlowOnly)
+        .network_on(Range::plane([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1e-9))
+        .pressure(Range::rect(-1e-6, -1e-6, 1e-6, 1e-6), p_a);
+    let mut sim = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+        .physics(flow)
+        .build()
+        .unwrap();
+    let stage = sim.field_stages()[0].clone();
+    assert_eq!(stage.cycle, SubCycle::Every(1));
+    let diffusivity = fluid.bulk_modulus * delta * delta / (12.0 * fluid.dynamic_viscosity());
+    let (mid, end) = (node_at(&sim, 0.5 * l), node_at(&sim, l));
+    let mut worst: f64 = 0.0;
+    for t_dimless in [0.05, 0.1, 0.2, 0.5, 1.0] {
+        sim.run_until(t_dimless * l * l / diffusivity).unwrap();
+        let t = sim.kinematics().time * diffusivity / (l * l);
+        let p = sim.field(FLOW_PRESSURE).unwrap();
+        for (node, x) in [(mid, 0.5 * l), (end, l)] {
+            let exact = fracture_closed_form(p_a, x, l, t);
+            worst = worst.max((p[node] - exact).abs() / p_a);
+        }
+    }
+    assert!(worst < 0.02, "worst error {worst} of p_A");
+    let b = mass_balance(&sim).unwrap();
+    assert!(b.boundary > 0.0, "fluid entered through the held node");
+    assert!(b.relative().abs() < 1e-12, "{b:?}");
+}
+
+#[test]
+fn a_closed_network_conserves_and_relaxes_to_uniform_pressure() {
+    // Gravity-free, closed, every joint a channel: pressure from a local injection
+    // spreads and the injected volume is all stored.
+    let mesh = split_nodes(
+        &builders::rectangle(0.0, 0.0, 0.4, 0.2, 0.05).unwrap(),
+        &Range::All,
+    )
+    .unwrap();
+    let model = FlowModel::new(Fluid::water(), Aperture::fixed(2e-5).unwrap());
+    let flow = Hydro::new(model)
+        .coupling(Coupling::FlowOnly)
+        .rate(Range::rect(0.19, 0.09, 0.21, 0.11), 1e-7);
+    let mut sim = Simulation::builder(mesh, Backend::cpu(2).unwrap())
+        .physics(flow)
+        .build()
+        .unwrap();
+    sim.run(3000).unwrap();
+    let b = mass_balance(&sim).unwrap();
+    assert!(b.injected > 0.0);
+    assert!(b.relative().abs() < 1e-12, "{b:?}");
+    assert!((b.change - b.injected).abs() <= 1e-12 * b.injected);
+    let p = sim.field(FLOW_PRESSURE).unwrap();
+    assert!(p.iter().all(|&x| x > 0.0));
+    let s = sim.field(FLOW_SATURATION).unwrap();
+    assert!(s.iter().all(|&x| x == 1.0));
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let run = |threads| {
+        let mesh = split_nodes(
+            &builders::rectangle(0.0, 0.0, 2.0, 1.0, 0.02).unwrap(),
+            &Range::All,
+        )
+        .unwrap();
+        let model = FlowModel::new(Fluid::water(), Aperture::fixed(1e-5).unwrap());
+        let flow = Hydro::new(model)
+            .coupling(Coupling::FlowOnly)
+            .gravity([0.0, -9.81, 0.0])
+            .head(Range::rect(-0.01, -0.01, 0.01, 1.01), 0.8)
+            .pressure(Range::rect(1.99, -0.01, 2.01, 1.01), 0.0);
+        let mut sim = Simulation::builder(mesh, Backend::cpu(threads).unwrap())
+            .physics(flow)
+            .build()
+            .unwrap();
+        sim.run(50).unwrap();
+        sim.field(FLOW_PRESSURE).unwrap().to_vec()
+    };
+    assert_eq!(run(1), run(2));
+}
