@@ -2,7 +2,7 @@
 //! the full examples.
 
 use pcdc::compute::Backend;
-use pcdc_validation::scenes::{kirsch, vibration_energy, wave_speed};
+use pcdc_validation::scenes::{fracture_flow, kirsch, vibration_energy, wave_speed};
 
 fn cpu() -> Backend {
     Backend::cpu(2).unwrap()
@@ -33,6 +33,18 @@ fn wave_speed_within_2_percent_2d_and_3d() {
             out.c_num, out.c_exact, out.error, out.elements, out.steps
         );
         assert!(out.error <= wave_speed::TOL, "{name}: {}", out.error);
+    }
+}
+
+#[test]
+fn fracture_flow_within_5_percent_of_pa_2d_and_3d() {
+    let (cpu, p) = (cpu(), fracture_flow::Params::reduced());
+    for (name, out) in [
+        ("2d", fracture_flow::run_2d(&cpu, &p).unwrap()),
+        ("3d", fracture_flow::run_3d(&cpu, &p).unwrap()),
+    ] {
+        assert!(out.error <= fracture_flow::TOL, "{name}: {}", out.error);
+        assert!(out.balance.abs() < 1e-12, "{name}: balance {}", out.balance);
     }
 }
 

@@ -14,6 +14,7 @@ pub mod block_sliding;
 pub mod brazilian;
 pub mod direct_tension;
 pub mod file;
+pub mod fracture_flow;
 pub mod fragmentation;
 pub mod kirsch;
 pub mod limits;
