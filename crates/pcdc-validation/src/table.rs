@@ -16,7 +16,8 @@ use pcdc_compute::{Backend, BackendKind, Precision};
 use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
-    block_sliding, brazilian, direct_tension, kirsch, ucs, vibration_energy, wave_speed,
+    block_sliding, brazilian, direct_tension, fracture_flow, kirsch, ucs, vibration_energy,
+    wave_speed,
 };
 
 /// One measured row of the report.
@@ -113,6 +114,7 @@ pub const CASES: &[&str] = &[
     "direct_tension",
     "ucs",
     "brazilian",
+    "fracture_flow",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -133,6 +135,7 @@ impl Job {
         match (self.case, self.variant) {
             ("wave_speed", "3d") => 2.0 * self.size,
             ("vibration_energy", "3d") => 2.5 * self.size,
+            ("fracture_flow", "3d") => 2.0 * self.size,
             _ => self.size,
         }
     }
@@ -195,6 +198,13 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("brazilian", "2P/(πD) vs Ts", size));
             }
         }
+        "fracture_flow" => {
+            let s = fracture_flow::Params::full().size;
+            for size in [4.0 * s, 2.0 * s, s] {
+                out.push(j("fracture_flow", "2d", size));
+                out.push(j("fracture_flow", "3d", size));
+            }
+        }
         _ => {}
     }
     out
@@ -236,6 +246,17 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
             };
             let o = kirsch::run(backend, &p, solver)?;
             within(o.elements, o.error, kirsch::TOL, o.steps)
+        }
+        "fracture_flow" => {
+            let p = fracture_flow::Params { size: job.size };
+            let o = if job.variant == "2d" {
+                fracture_flow::run_2d(backend, &p)?
+            } else {
+                fracture_flow::run_3d(backend, &p)?
+            };
+            // The flow channels are the unknowns of this scene: they fill the elements
+            // column.
+            within(o.channels, o.error, fracture_flow::TOL, o.steps)
         }
         "wave_speed" => {
             let p = wave_speed::Params { size: job.size };
@@ -379,7 +400,8 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
          vibration_energy: energy drift; block_sliding: stopping distance; direct_tension: \
          peak neck stress against Ts, signed; ucs: Young's modulus from 20–50 % of the \
          peak against the input E, with UCS/Ts in the tolerance column; brazilian: \
-         2P/(πD) / Ts − 1). Wall time includes the build; \
+         2P/(πD) / Ts − 1; fracture_flow: largest |p − p_exact| / p_A at x = L/2 and L, \
+         its elements column counting flow channels). Wall time includes the build; \
          element-steps/s = elements × steps / wall time (the direct Kirsch solve counts \
          its iterations as steps). GPU rows on a software adapter (Mesa's lavapipe) \
          show that the path works and what it costs there, not GPU speed.\n\n",
