@@ -61,3 +61,27 @@ pub fn mass_balance<D: Dim>(sim: &Simulation<D>) -> Result<MassBalance, ComputeE
     m.residual = m.change - m.injected - m.boundary + m.leaked;
     Ok(m)
 }
+
+/// History columns of the mass balance, to add to a [`pcdc_compute::History`] with
+/// `history.probe(name, probe)`: `injected`, `stored_change`, `leaked`, `boundary` (m³)
+/// and `balance_residual` (m³, zero to rounding). NaN in a simulation without
+/// [`crate::Hydro`].
+pub fn balance_probes<D: Dim>() -> Vec<(&'static str, pcdc_compute::Probe<D>)> {
+    type Term = fn(&MassBalance) -> f64;
+    let terms: [(&'static str, Term); 5] = [
+        ("injected", |b| b.injected),
+        ("stored_change", |b| b.change),
+        ("leaked", |b| b.leaked),
+        ("boundary", |b| b.boundary),
+        ("balance_residual", |b| b.residual),
+    ];
+    terms
+        .into_iter()
+        .map(|(name, f)| {
+            let probe = pcdc_compute::Probe::Custom(Box::new(move |sim: &Simulation<D>| {
+                mass_balance(sim).map_or(f64::NAN, |b| f(&b))
+            }));
+            (name, probe)
+        })
+        .collect()
+}

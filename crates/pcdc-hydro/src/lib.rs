@@ -80,7 +80,7 @@ pub mod network;
 pub mod output;
 mod physics;
 
-pub use balance::{mass_balance, MassBalance};
+pub use balance::{balance_probes, mass_balance, MassBalance};
 pub use model::{saturation_weight, Aperture, FlowModel, Fluid, LeakOff};
 pub use network::Network;
 pub use physics::{Coupling, Hydro};

@@ -88,7 +88,20 @@ fn a_closed_network_conserves_and_relaxes_to_uniform_pressure() {
         .physics(flow)
         .build()
         .unwrap();
-    sim.run(3000).unwrap();
+    let mut history = pcdc_compute::History::new();
+    for (name, probe) in pcdc_hydro::balance_probes() {
+        history = history.probe(name, probe);
+    }
+    for _ in 0..3 {
+        sim.run(1000).unwrap();
+        history.sample(&sim).unwrap();
+    }
+    let injected = history.column(0);
+    assert!(injected.windows(2).all(|w| w[1] > w[0]), "{injected:?}");
+    assert!(history
+        .column(4)
+        .iter()
+        .all(|r| r.abs() <= 1e-12 * injected[2]));
     let b = mass_balance(&sim).unwrap();
     assert!(b.injected > 0.0);
     assert!(b.relative().abs() < 1e-12, "{b:?}");
@@ -121,4 +134,61 @@ fn results_do_not_depend_on_the_thread_count() {
         sim.field(FLOW_PRESSURE).unwrap().to_vec()
     };
     assert_eq!(run(1), run(2));
+}
+
+/// Calibrated to a rock mass permeability, the intact 2D network is the linear finite
+/// element discretisation of Darcy flow: on a ring mesh (graded, unstructured) with a
+/// linear pressure held on both boundaries it carries that field exactly (the patch
+/// test). A uniform virtual aperture does not.
+#[test]
+fn calibrated_network_passes_the_patch_test() {
+    let mesh = builders::ring([0.0, 0.0], 0.3, 1.0, 0.05, 0.15).unwrap();
+    let field = |x: &[f64]| 1e6 * (1.0 + 0.5 * x[0] - 0.2 * x[1]);
+    let split = split_nodes(&mesh, &Range::All).unwrap();
+    let mut boundary: Vec<u32> = mesh.groups().nodes["inner"].clone();
+    boundary.extend_from_slice(&mesh.groups().nodes["outer"]);
+    let run = |calibrated: bool| {
+        let model = FlowModel::new(Fluid::water(), Aperture::new(1e-6, 1e-9, 1e-3).unwrap());
+        let mut flow = Hydro::new(model).coupling(Coupling::FlowOnly);
+        for &n in &boundary {
+            let x = mesh.node(n as usize);
+            let at = Range::Ball {
+                center: [x[0], x[1], 0.0],
+                radius: 1e-6,
+            };
+            flow = flow.pressure(at, field(x));
+        }
+        if calibrated {
+            flow = flow.rock_permeability(1e-14);
+        }
+        let mut sim = Simulation::builder(split.clone(), Backend::cpu(1).unwrap())
+            .physics(flow)
+            .build()
+            .unwrap();
+        let mut last = sim.field(FLOW_PRESSURE).unwrap().to_vec();
+        for _ in 0..5000 {
+            sim.run(200).unwrap();
+            let p = sim.field(FLOW_PRESSURE).unwrap();
+            let change = p
+                .iter()
+                .zip(&last)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            last.copy_from_slice(p);
+            if change < 1e-6 {
+                break;
+            }
+        }
+        let set = sim.entity_set(pcdc_hydro::fields::FLOW_NODES).unwrap();
+        (0..set.len())
+            .map(|l| (last[l] - field(sim.mesh().node(set.entity(l)[0] as usize))).abs() / 1e6)
+            .fold(0.0, f64::max)
+    };
+    let calibrated = run(true);
+    let uniform = run(false);
+    assert!(calibrated < 1e-6, "calibrated network: {calibrated}");
+    assert!(
+        uniform > 1e-3,
+        "a uniform aperture on a graded mesh: {uniform}"
+    );
 }
