@@ -2,7 +2,7 @@
 //! the full examples.
 
 use pcdc::compute::Backend;
-use pcdc_validation::scenes::{fracture_flow, kirsch, vibration_energy, wave_speed};
+use pcdc_validation::scenes::{fracture_flow, kirsch, radial_flow, vibration_energy, wave_speed};
 
 fn cpu() -> Backend {
     Backend::cpu(2).unwrap()
@@ -45,6 +45,21 @@ fn fracture_flow_within_5_percent_of_pa_2d_and_3d() {
     ] {
         assert!(out.error <= fracture_flow::TOL, "{name}: {}", out.error);
         assert!(out.balance.abs() < 1e-12, "{name}: balance {}", out.balance);
+    }
+}
+
+/// Scene 9 in 2D within its 2 % tolerance. The 3D variant misses it (5.5 % at this size,
+/// 3.0 % at the full one: a known limit of the face network, see
+/// `scenes::radial_flow::run_3d`); its bound here only guards against a regression.
+#[test]
+fn radial_flow_within_2_percent_in_2d_and_bounded_in_3d() {
+    let (cpu, p) = (cpu(), radial_flow::Params::reduced());
+    let o2 = radial_flow::run_2d(&cpu, &p).unwrap();
+    assert!(o2.error <= radial_flow::TOL, "2d: {}", o2.error);
+    let o3 = radial_flow::run_3d(&cpu, &p).unwrap();
+    assert!(o3.error <= 0.06, "3d: {}", o3.error);
+    for o in [&o2, &o3] {
+        assert!(o.balance.abs() < 1e-9, "balance {}", o.balance);
     }
 }
 

@@ -19,6 +19,7 @@ pub mod fragmentation;
 pub mod kirsch;
 pub mod limits;
 pub mod platen_test;
+pub mod radial_flow;
 pub mod ucs;
 pub mod vibration_energy;
 pub mod wave_speed;
