@@ -37,8 +37,6 @@ use crate::model::{saturation_weight, Aperture, LeakOff};
 pub struct Geometry {
     /// Channel measure A: length (2D, m) or area (3D, m²).
     pub measure: Vec<f64>,
-    /// Unit normal of the midplane (side A to side B), stride D.
-    pub normal: Vec<f64>,
     /// Hydraulic aperture δ (m), eq. 79.
     pub aperture: Vec<f64>,
     /// Edge weights, 3 per channel: 2D (0,1) in slot 0; 3D (0,1), (1,2), (2,0).
@@ -72,6 +70,7 @@ pub struct Shape {
 /// The shape of one channel from its midplane points `mid` and the pair gaps `gap`
 /// (x_B − x_A), `npc` of each. A degenerate channel has zero measure, weights and
 /// gradients (it carries no flow and stores nothing).
+#[inline]
 pub fn channel_shape(npc: usize, mid: &[[f64; 3]; 3], gap: &[[f64; 3]; 3]) -> Shape {
     let mut sh = Shape::default();
     if npc == 2 {
@@ -109,6 +108,27 @@ pub fn channel_shape(npc: usize, mid: &[[f64; 3]; 3], gap: &[[f64; 3]; 3]) -> Sh
     }
     sh.opening /= npc as f64;
     sh
+}
+
+/// Measure and unit normal of a channel from its midplane points: the same arithmetic as
+/// [`channel_shape`], without the rest (the pressure forces need only these).
+#[inline]
+pub fn measure_normal(npc: usize, mid: &[[f64; 3]; 3]) -> (f64, [f64; 3]) {
+    if npc == 2 {
+        let (dx, dy) = (mid[1][0] - mid[0][0], mid[1][1] - mid[0][1]);
+        let len = (dx * dx + dy * dy).sqrt();
+        if len > 0.0 {
+            return (len, [dy / len, -dx / len, 0.0]);
+        }
+        return (len, [0.0; 3]);
+    }
+    let c = cross(sub(mid[1], mid[0]), sub(mid[2], mid[0]));
+    let twice = dot(c, c).sqrt();
+    if twice > 0.0 {
+        (0.5 * twice, [c[0] / twice, c[1] / twice, c[2] / twice])
+    } else {
+        (0.5 * twice, [0.0; 3])
+    }
 }
 
 /// The mean flux q = −k ∇ψ of a channel (m²/s: volume per unit time and unit width), with

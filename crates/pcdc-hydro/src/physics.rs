@@ -507,14 +507,13 @@ impl Hydro {
     fn update_geometry<D: Dim>(&mut self, kin: &Kinematics<'_, D>) {
         let d = self.derived.as_ref().expect("init ran");
         let (net, npc, dd) = (&d.net, d.net.npc, D::D);
-        let joints = kin.mesh.interfaces();
+        let jn = &d.channel_joint_nodes;
         let follows = self.follows_solid();
         let model = self.model.aperture;
         let g = self.gravity;
         let geom = &mut self.geom;
         let nc = net.n_channels();
         geom.measure.resize(nc, 0.0);
-        geom.normal.resize(nc * dd, 0.0);
         geom.aperture.resize(nc, 0.0);
         geom.weight.resize(nc * 3, 0.0);
         geom.gravity_potential.resize(nc * npc, 0.0);
@@ -522,51 +521,46 @@ impl Hydro {
         let delta0 = &d.delta0;
         geom.measure
             .par_chunks_mut(CHUNK)
-            .zip(geom.normal.par_chunks_mut(CHUNK * dd))
             .zip(geom.aperture.par_chunks_mut(CHUNK))
             .zip(geom.weight.par_chunks_mut(CHUNK * 3))
             .zip(geom.gravity_potential.par_chunks_mut(CHUNK * npc))
             .zip(geom.grad.par_chunks_mut(CHUNK * npc * dd))
             .enumerate()
-            .for_each(
-                |(b, (((((measure, normal), aperture), weight), gpot), grad))| {
-                    for i in 0..measure.len() {
-                        let c = b * CHUNK + i;
-                        let nodes = joints.joint_nodes(net.joint[c] as usize);
-                        let mut mid = [[0.0; 3]; 3];
-                        let mut gap = [[0.0; 3]; 3];
-                        for k in 0..npc {
-                            let (xa, xb) = if follows {
-                                (
-                                    kin.position(nodes[k] as usize),
-                                    kin.position(nodes[npc + k] as usize),
-                                )
-                            } else {
-                                let mut xa = [0.0; 3];
-                                let mut xb = [0.0; 3];
-                                xa[..dd].copy_from_slice(kin.mesh.node(nodes[k] as usize));
-                                xb[..dd].copy_from_slice(kin.mesh.node(nodes[npc + k] as usize));
-                                (xa, xb)
-                            };
-                            for q in 0..3 {
-                                mid[k][q] = 0.5 * (xa[q] + xb[q]);
-                                gap[k][q] = xb[q] - xa[q];
-                            }
-                            gpot[i * npc + k] =
-                                g[0] * mid[k][0] + g[1] * mid[k][1] + g[2] * mid[k][2];
+            .for_each(|(b, ((((measure, aperture), weight), gpot), grad))| {
+                for i in 0..measure.len() {
+                    let c = b * CHUNK + i;
+                    let nodes = &jn[c * 2 * npc..(c + 1) * 2 * npc];
+                    let mut mid = [[0.0; 3]; 3];
+                    let mut gap = [[0.0; 3]; 3];
+                    for k in 0..npc {
+                        let (xa, xb) = if follows {
+                            (
+                                kin.position(nodes[k] as usize),
+                                kin.position(nodes[npc + k] as usize),
+                            )
+                        } else {
+                            let mut xa = [0.0; 3];
+                            let mut xb = [0.0; 3];
+                            xa[..dd].copy_from_slice(kin.mesh.node(nodes[k] as usize));
+                            xb[..dd].copy_from_slice(kin.mesh.node(nodes[npc + k] as usize));
+                            (xa, xb)
+                        };
+                        for q in 0..3 {
+                            mid[k][q] = 0.5 * (xa[q] + xb[q]);
+                            gap[k][q] = xb[q] - xa[q];
                         }
-                        let sh = flow::channel_shape(npc, &mid, &gap);
-                        measure[i] = sh.measure;
-                        normal[i * dd..(i + 1) * dd].copy_from_slice(&sh.normal[..dd]);
-                        aperture[i] = flow::aperture_of(&model, delta0[c], sh.opening, follows);
-                        weight[i * 3..i * 3 + 3].copy_from_slice(&sh.weight);
-                        for k in 0..npc {
-                            grad[(i * npc + k) * dd..(i * npc + k + 1) * dd]
-                                .copy_from_slice(&sh.grad[k][..dd]);
-                        }
+                        gpot[i * npc + k] = g[0] * mid[k][0] + g[1] * mid[k][1] + g[2] * mid[k][2];
                     }
-                },
-            );
+                    let sh = flow::channel_shape(npc, &mid, &gap);
+                    measure[i] = sh.measure;
+                    aperture[i] = flow::aperture_of(&model, delta0[c], sh.opening, follows);
+                    weight[i * 3..i * 3 + 3].copy_from_slice(&sh.weight);
+                    for k in 0..npc {
+                        grad[(i * npc + k) * dd..(i * npc + k + 1) * dd]
+                            .copy_from_slice(&sh.grad[k][..dd]);
+                    }
+                }
+            });
         let inv = 1.0 / npc as f64;
         let (measure, aperture) = (&geom.measure, &geom.aperture);
         geom.node_volume.resize(net.n_nodes(), 0.0);
@@ -982,7 +976,7 @@ impl<D: Dim> Physics<D> for Hydro {
         }
         let p = ctx.fields.get(ids.pressure);
         let kin = &ctx.kin;
-        let joints = kin.mesh.interfaces();
+        let jn = &d.channel_joint_nodes;
         let stride = 2 * npc * dd;
         ctx.slots
             .par_chunks_mut(CHUNK * stride)
@@ -990,7 +984,7 @@ impl<D: Dim> Physics<D> for Hydro {
             .for_each(|(b, slots)| {
                 for i in 0..slots.len() / stride {
                     let c = b * CHUNK + i;
-                    let nodes = joints.joint_nodes(net.joint[c] as usize);
+                    let nodes = &jn[c * 2 * npc..(c + 1) * 2 * npc];
                     let mut mid = [[0.0; 3]; 3];
                     for k in 0..npc {
                         let (xa, xb) = (
@@ -1001,8 +995,7 @@ impl<D: Dim> Physics<D> for Hydro {
                             mid[k][q] = 0.5 * (xa[q] + xb[q]);
                         }
                     }
-                    let sh = flow::channel_shape(npc, &mid, &[[0.0; 3]; 3]);
-                    let (a, n) = (sh.measure, sh.normal);
+                    let (a, n) = flow::measure_normal(npc, &mid);
                     let pk: [f64; 3] = std::array::from_fn(|k| {
                         if k < npc {
                             p[net.channel_nodes[c * npc + k] as usize]
