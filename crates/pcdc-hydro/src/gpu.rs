@@ -102,23 +102,10 @@ impl Hydro {
             let v = v.clone();
             rate_sig.push(setup.signal(move |t, dt| v.at(t + dt)));
         }
-        // Rate entries per node, in the order the CPU adds them.
-        let mut rate_ptr = vec![0u32; nf + 1];
-        for &(l, _, _) in &d.rates {
-            rate_ptr[l as usize + 1] += 1;
-        }
-        for l in 0..nf {
-            rate_ptr[l + 1] += rate_ptr[l];
-        }
-        let mut fill = rate_ptr.clone();
-        let mut rsig = vec![0u32; d.rates.len()];
-        let mut rshare = vec![0.0; d.rates.len()];
-        for &(l, i, s) in &d.rates {
-            let at = fill[l as usize] as usize;
-            rsig[at] = rate_sig[i];
-            rshare[at] = s;
-            fill[l as usize] += 1;
-        }
+        // Rate entries per node, the CPU's list (same order).
+        let rsig: Vec<u32> = d.rate_cond.iter().map(|&i| rate_sig[i as usize]).collect();
+        let rate_ptr = d.rate_ptr.clone();
+        let rshare = d.rate_share.clone();
         let bc = setup.upload("hydro conditions", GpuData::U32(bc));
         let elev = setup.upload("hydro elevation", GpuData::Real(d.elevation.clone()));
         let rate_ptr = setup.upload("hydro rate ptr", GpuData::U32(rate_ptr));

@@ -105,8 +105,12 @@ pub(crate) struct Derived {
     pub(crate) fixed_values: Vec<(bool, TimeValue)>,
     /// Elevation z = −ĝ·x of each flow node (m), for head conditions.
     pub(crate) elevation: Vec<f64>,
-    /// Rate conditions: flow node, condition value index, share.
-    pub(crate) rates: Vec<(u32, usize, f64)>,
+    /// Rate conditions per flow node: entries `rate_ptr[l]..rate_ptr[l + 1]` of
+    /// `rate_cond` (index into `rate_values`) and `rate_share` (its share of the rate),
+    /// in the order the conditions were given; read by the CPU and GPU node updates.
+    pub(crate) rate_ptr: Vec<u32>,
+    pub(crate) rate_cond: Vec<u32>,
+    pub(crate) rate_share: Vec<f64>,
     pub(crate) rate_values: Vec<TimeValue>,
     slots: Option<SlotBlock>,
 }
@@ -153,6 +157,8 @@ pub struct Hydro {
     share: Vec<f64>,
     /// Per channel, the volume each of its nodes loses to leak-off over the step (m³).
     leak: Vec<f64>,
+    /// Pressure/head condition values, then rate values, at the current step.
+    values: Vec<f64>,
 }
 
 impl Hydro {
@@ -176,6 +182,7 @@ impl Hydro {
             geom: Geometry::default(),
             share: Vec::new(),
             leak: Vec::new(),
+            values: Vec::new(),
         }
     }
 
@@ -489,6 +496,23 @@ impl Hydro {
                 }
             }
         }
+        // Per node, in the order given (a counting sort keeps it).
+        let mut rate_ptr = vec![0u32; net.n_nodes() + 1];
+        for &(l, _, _) in &rates {
+            rate_ptr[l as usize + 1] += 1;
+        }
+        for l in 0..net.n_nodes() {
+            rate_ptr[l + 1] += rate_ptr[l];
+        }
+        let mut fill = rate_ptr.clone();
+        let mut rate_cond = vec![0u32; rates.len()];
+        let mut rate_share = vec![0.0; rates.len()];
+        for &(l, i, share) in &rates {
+            let at = fill[l as usize] as usize;
+            rate_cond[at] = i as u32;
+            rate_share[at] = share;
+            fill[l as usize] += 1;
+        }
         let mut channel_joint_nodes = Vec::with_capacity(net.n_channels() * 2 * net.npc);
         for &j in &net.joint {
             channel_joint_nodes.extend_from_slice(mesh.interfaces().joint_nodes(j as usize));
@@ -501,7 +525,9 @@ impl Hydro {
             fixed,
             fixed_values,
             elevation,
-            rates,
+            rate_ptr,
+            rate_cond,
+            rate_share,
             rate_values,
             slots: None,
         })
@@ -1118,11 +1144,14 @@ impl<D: Dim> Physics<D> for Hydro {
         // value at the end of the mechanical step (every sub-step of it alike, as the GPU
         // reads them once per step).
         let t_end = ctx.kin.time;
-        let fixed_now: Vec<f64> = d.fixed_values.iter().map(|(_, v)| v.at(t_end)).collect();
-        let mut inject = vec![0.0; net.n_nodes()];
-        for &(l, i, share) in &d.rates {
-            inject[l as usize] += d.rate_values[i].at(t_end) * share * dt;
-        }
+        // The conditions' values now, in a buffer kept between steps.
+        let mut values = std::mem::take(&mut self.values);
+        values.clear();
+        values.extend(d.fixed_values.iter().map(|(_, v)| v.at(t_end)));
+        let (fixed_now, rate_now) = {
+            values.extend(d.rate_values.iter().map(|v| v.at(t_end)));
+            values.split_at(d.fixed_values.len())
+        };
         let g_abs = self.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
         let [w, p, s, bal] =
             ctx.fields
@@ -1143,8 +1172,12 @@ impl<D: Dim> Physics<D> for Hydro {
                     }
                     // The change since the start, so that the balance sums changes, not
                     // contents (no cancellation against the stored volume).
-                    let trial = w[i] + gain - lost + inject[l];
-                    bal[i * 4 + 1] += inject[l];
+                    let mut inject = 0.0;
+                    for r in d.rate_ptr[l] as usize..d.rate_ptr[l + 1] as usize {
+                        inject += rate_now[d.rate_cond[r] as usize] * d.rate_share[r] * dt;
+                    }
+                    let trial = w[i] + gain - lost + inject;
+                    bal[i * 4 + 1] += inject;
                     bal[i * 4 + 3] += lost;
                     let (v, w0) = (vol[l], bal[i * 4]);
                     let mut next = trial;
@@ -1168,6 +1201,7 @@ impl<D: Dim> Physics<D> for Hydro {
                     s[i] = sn;
                 }
             });
+        self.values = values;
         if let Some(l) = p.iter().position(|x| !x.is_finite()) {
             let x = ctx.kin.mesh.node(net.node_mesh[l] as usize);
             return Err(ComputeError::Diverged {
