@@ -8,6 +8,22 @@ use pcdc_hydro::{mass_balance, Aperture, Coupling, FlowModel, Fluid, Hydro, Leak
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, split_nodes, Dim, Dim2, Mesh, Range};
 
+/// The joints of the coupled tests: intrinsic CZM of tensile strength `ts` (Pa).
+fn czm(ts: f64) -> pcdc_cohesive::IntrinsicCzm {
+    IntrinsicCzmParams {
+        friction_deg: 30.0,
+        cohesion: 2.0 * ts,
+        tensile_strength: ts,
+        gf1: 1.0,
+        gf2: 10.0,
+        penalty_open: 1e11,
+        penalty_shear: 1e11,
+        penalty_overlap: 1e12,
+    }
+    .build()
+    .unwrap()
+}
+
 fn max_rel(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
     let scale = a.iter().map(|x| x.abs()).fold(0.0, f64::max).max(1e-300);
@@ -120,18 +136,7 @@ fn two_way_injection_with_joints_and_leak_off_matches_cpu() {
             .unwrap()
             .with_damping(0.5)
             .unwrap();
-        let czm = IntrinsicCzmParams {
-            friction_deg: 30.0,
-            cohesion: 2e5,
-            tensile_strength: 1e5,
-            gf1: 1.0,
-            gf2: 10.0,
-            penalty_open: 1e11,
-            penalty_shear: 1e11,
-            penalty_overlap: 1e12,
-        }
-        .build()
-        .unwrap();
+        let czm = czm(1e5);
         let model = FlowModel::new(Fluid::water(), Aperture::new(1e-5, 1e-6, 1e-3).unwrap())
             .with_leak_off(LeakOff {
                 pore_pressure: 0.0,
@@ -176,18 +181,7 @@ fn two_way_injection_in_tetrahedra_matches_cpu() {
             .unwrap()
             .with_damping(0.5)
             .unwrap();
-        let czm = IntrinsicCzmParams {
-            friction_deg: 30.0,
-            cohesion: 2e7,
-            tensile_strength: 1e7,
-            gf1: 1.0,
-            gf2: 10.0,
-            penalty_open: 1e11,
-            penalty_shear: 1e11,
-            penalty_overlap: 1e12,
-        }
-        .build()
-        .unwrap();
+        let czm = czm(1e7);
         let model = FlowModel::new(Fluid::water(), Aperture::new(1e-5, 1e-6, 1e-3).unwrap());
         let flow = Hydro::new(model)
             .bulk_modulus_scale(0.01)

@@ -327,18 +327,10 @@ impl PvdSeries {
         point_data: &[DataArray],
         cell_data: &[DataArray],
     ) -> Result<PathBuf, MeshError> {
-        let file_name = format!("{}_{:06}.vtu", self.base_name, self.steps.len());
-        let path = self.dir.join(&file_name);
-        if !time.is_finite() {
-            return Err(MeshError::Io {
-                path: path.display().to_string(),
-                source: invalid(format!("time {time} is not finite")),
-            });
-        }
-        write_vtu_with(&path, mesh, points, point_data, cell_data, self.encoding)?;
-        self.steps.push((time, file_name));
-        self.write_pvd()?;
-        Ok(path)
+        let encoding = self.encoding;
+        self.add_step(time, |path| {
+            write_vtu_with(path, mesh, points, point_data, cell_data, encoding)
+        })
     }
 
     /// Writes the next step of [`Cells`] ([`write_cells_vtu`]) and updates the `.pvd`
@@ -350,6 +342,19 @@ impl PvdSeries {
         point_data: &[DataArray],
         cell_data: &[DataArray],
     ) -> Result<PathBuf, MeshError> {
+        let encoding = self.encoding;
+        self.add_step(time, |path| {
+            write_cells_vtu::<D>(path, cells, point_data, cell_data, encoding)
+        })
+    }
+
+    /// Writes the next step's file with `write` (refusing a non-finite time), then lists
+    /// it in the `.pvd` file.
+    fn add_step(
+        &mut self,
+        time: f64,
+        write: impl FnOnce(&Path) -> Result<(), MeshError>,
+    ) -> Result<PathBuf, MeshError> {
         let file_name = format!("{}_{:06}.vtu", self.base_name, self.steps.len());
         let path = self.dir.join(&file_name);
         if !time.is_finite() {
@@ -358,7 +363,7 @@ impl PvdSeries {
                 source: invalid(format!("time {time} is not finite")),
             });
         }
-        write_cells_vtu::<D>(&path, cells, point_data, cell_data, self.encoding)?;
+        write(&path)?;
         self.steps.push((time, file_name));
         self.write_pvd()?;
         Ok(path)

@@ -16,8 +16,8 @@ use pcdc_compute::{Backend, BackendKind, Precision};
 use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
-    block_sliding, brazilian, direct_tension, fracture_flow, kirsch, radial_flow, ucs,
-    vibration_energy, wave_speed,
+    block_sliding, brazilian, direct_tension, fracture_flow, kirsch, ucs, vibration_energy,
+    wave_speed,
 };
 
 /// One measured row of the report.
@@ -198,12 +198,6 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("brazilian", "2P/(πD) vs Ts", size));
             }
         }
-        "radial_flow" => {
-            for size in radial_flow::SIZES {
-                out.push(j("radial_flow", "2d", size));
-                out.push(j("radial_flow", "3d", size));
-            }
-        }
         "fracture_flow" => {
             let s = fracture_flow::Params::full().size;
             for size in [4.0 * s, 2.0 * s, s] {
@@ -252,15 +246,6 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
             };
             let o = kirsch::run(backend, &p, solver)?;
             within(o.elements, o.error, kirsch::TOL, o.steps)
-        }
-        "radial_flow" => {
-            let p = radial_flow::Params { size: job.size };
-            let o = if job.variant == "2d" {
-                radial_flow::run_2d(backend, &p)?
-            } else {
-                radial_flow::run_3d(backend, &p)?
-            };
-            within(o.channels, o.error, radial_flow::TOL, o.steps)
         }
         "fracture_flow" => {
             let p = fracture_flow::Params { size: job.size };
@@ -415,9 +400,8 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
          vibration_energy: energy drift; block_sliding: stopping distance; direct_tension: \
          peak neck stress against Ts, signed; ucs: Young's modulus from 20–50 % of the \
          peak against the input E, with UCS/Ts in the tolerance column; brazilian: \
-         2P/(πD) / Ts − 1; radial_flow: largest |p − p_exact| / (p_i − p_o) over the flow nodes; \
-         fracture_flow: largest |p − p_exact| / p_A at x = L/2 and L; the elements column \
-         of both counts flow channels). Wall time includes the build; \
+         2P/(πD) / Ts − 1; fracture_flow: largest |p − p_exact| / p_A at x = L/2 and L, \
+         its elements column counting flow channels). Wall time includes the build; \
          element-steps/s = elements × steps / wall time (the direct Kirsch solve counts \
          its iterations as steps). GPU rows on a software adapter (Mesa's lavapipe) \
          show that the path works and what it costs there, not GPU speed.\n\n",
