@@ -91,6 +91,7 @@ struct Ids {
 }
 
 /// Data derived at init.
+#[derive(Clone)]
 pub(crate) struct Derived {
     pub(crate) net: Network,
     /// The joint nodes (side A, then side B) of every channel.
@@ -151,6 +152,9 @@ pub struct Hydro {
     conditions: Vec<Condition>,
     schedule: FieldSchedule,
     pub(crate) derived: Option<Derived>,
+    /// The derivation made for the builder's first questions (sets, fields), kept for
+    /// init so that the network is built once: (mesh key, data).
+    prepared: std::sync::OnceLock<((usize, usize, usize), Derived)>,
     ids: Option<Ids>,
     pub(crate) geom: Geometry,
     /// Per channel node, the volume flowing in over the current field step (m³).
@@ -178,6 +182,7 @@ impl Hydro {
             conditions: Vec::new(),
             schedule: FieldSchedule::Auto,
             derived: None,
+            prepared: std::sync::OnceLock::new(),
             ids: None,
             geom: Geometry::default(),
             share: Vec::new(),
@@ -400,6 +405,25 @@ impl Hydro {
             }
         }
         Ok(())
+    }
+
+    /// The derivation for `mesh`, made once and kept (a different mesh is derived
+    /// afresh).
+    fn prepared<D: Dim>(
+        &self,
+        mesh: &Mesh<D>,
+    ) -> Result<std::borrow::Cow<'_, Derived>, ComputeError> {
+        let key = mesh_key(mesh);
+        if let Some((k, d)) = self.prepared.get() {
+            if *k == key {
+                return Ok(std::borrow::Cow::Borrowed(d));
+            }
+            return self.derive(mesh).map(std::borrow::Cow::Owned);
+        }
+        let d = self.derive(mesh)?;
+        Ok(std::borrow::Cow::Borrowed(
+            &self.prepared.get_or_init(|| (key, d)).1,
+        ))
     }
 
     /// Builds the network and resolves fractures and conditions on `mesh`.
@@ -769,6 +793,11 @@ fn calibrated_aperture<D: Dim>(mesh: &Mesh<D>, j: usize, k: f64) -> f64 {
     }
 }
 
+/// What identifies the mesh a derivation was made for.
+fn mesh_key<D: Dim>(mesh: &Mesh<D>) -> (usize, usize, usize) {
+    (mesh.n_nodes(), mesh.n_elements(), mesh.interfaces().len())
+}
+
 /// The unit vector along −g (up), or zero without gravity.
 fn unit_up(g: [f64; 3]) -> [f64; 3] {
     let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
@@ -787,7 +816,7 @@ impl<D: Dim> Physics<D> for Hydro {
     fn entity_sets(&self, mesh: &Mesh<D>) -> Vec<EntitySet> {
         // Errors surface in init (the same derivation); an invalid network gives no sets
         // here, and init reports why.
-        let Ok(d) = self.derive(mesh) else {
+        let Ok(d) = self.prepared(mesh) else {
             return Vec::new();
         };
         let joints = mesh.interfaces();
@@ -808,7 +837,7 @@ impl<D: Dim> Physics<D> for Hydro {
     fn fields(&self, mesh: &Mesh<D>) -> Vec<FieldUse> {
         // Without a valid network there are no sets to put the fields on: declare none,
         // and let init report why.
-        if self.derive(mesh).is_err() {
+        if self.prepared(mesh).is_err() {
             return Vec::new();
         }
         let mut f = vec![
@@ -828,7 +857,11 @@ impl<D: Dim> Physics<D> for Hydro {
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
-        let mut derived = self.derive(ctx.mesh)?;
+        let key = mesh_key(ctx.mesh);
+        let mut derived = match self.prepared.take() {
+            Some((k, d)) if k == key => d,
+            _ => self.derive(ctx.mesh)?,
+        };
         let fields = &mut *ctx.fields;
         let ids = Ids {
             content: fields.id(FLOW_STORED)?,
