@@ -192,3 +192,44 @@ fn calibrated_network_passes_the_patch_test() {
         "a uniform aperture on a graded mesh: {uniform}"
     );
 }
+
+/// The same fracture in SI and in millimetre–newton–second units (tonnes, MPa, mm²/s)
+/// gives the same step and the same p/p_A: no unit system is built in.
+#[test]
+fn results_do_not_depend_on_the_unit_system() {
+    let run = |l: f64, delta: f64, fluid: Fluid, p_a: f64| {
+        let mesh = split_nodes(
+            &builders::rectangle(0.0, -0.1 * l, l, 0.2 * l, 0.05 * l).unwrap(),
+            &Range::All,
+        )
+        .unwrap();
+        let e = 1e-6 * l;
+        let flow = Hydro::new(FlowModel::new(fluid, Aperture::fixed(delta).unwrap()))
+            .coupling(Coupling::FlowOnly)
+            .network_on(Range::plane([0.0; 3], [0.0, 1.0, 0.0], e))
+            .pressure(Range::rect(-e, -e, e, e), p_a);
+        let mut sim = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+            .physics(flow)
+            .build()
+            .unwrap();
+        sim.run(300).unwrap();
+        let p: Vec<f64> = sim
+            .field(FLOW_PRESSURE)
+            .unwrap()
+            .iter()
+            .map(|p| p / p_a)
+            .collect();
+        (sim.dt(), p)
+    };
+    let (dt_si, p_si) = run(1.0, 1e-4, Fluid::water(), 1e6);
+    let mm = Fluid::new(1e-9, 2200.0, 1.0).unwrap();
+    let (dt_mm, p_mm) = run(1000.0, 0.1, mm, 1.0);
+    assert!((dt_si - dt_mm).abs() <= 1e-12 * dt_si, "{dt_si} vs {dt_mm}");
+    let worst = p_si
+        .iter()
+        .zip(&p_mm)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(p_si.iter().any(|&x| x > 0.1));
+    assert!(worst < 1e-9, "p/p_A differs by {worst}");
+}
