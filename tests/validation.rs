@@ -2,7 +2,9 @@
 //! the full examples.
 
 use pcdc::compute::Backend;
-use pcdc_validation::scenes::{fracture_flow, kirsch, radial_flow, vibration_energy, wave_speed};
+use pcdc_validation::scenes::{
+    fracture_flow, injection, kirsch, radial_flow, unconfined_flow, vibration_energy, wave_speed,
+};
 
 fn cpu() -> Backend {
     Backend::cpu(2).unwrap()
@@ -195,4 +197,65 @@ fn result_line_names_the_backend_it_ran_on() {
     let text = line.to_string();
     assert!(text.ends_with(" backend=cpu precision=f64"), "{text}");
     assert!(text.contains(" pass=true "), "{text}");
+}
+
+/// Scene 10 at reduced size: the free surface within 5 % of h_l of the Dupuit parabola,
+/// the discharge within 12 % of Dupuit–Charny (first order in the element size: 10 % at
+/// this size, 2.5 % at the full one), the balance closed, and a steady state that does
+/// not depend on the scaled fluid bulk modulus.
+#[test]
+fn unconfined_flow_follows_dupuit_whatever_the_bulk_modulus_scale() {
+    let cpu = cpu();
+    let p = unconfined_flow::Params::reduced();
+    let a = unconfined_flow::run(&cpu, &p).unwrap();
+    eprintln!(
+        "dupuit: surface {:.4} discharge {:.4} steps {}",
+        a.error, a.discharge_error, a.steps
+    );
+    assert!(a.error <= unconfined_flow::TOL, "surface: {}", a.error);
+    assert!(
+        a.discharge_error <= 0.12,
+        "discharge: {}",
+        a.discharge_error
+    );
+    assert!(a.balance.abs() < 1e-12, "balance {}", a.balance);
+    let b = unconfined_flow::run(
+        &cpu,
+        &unconfined_flow::Params {
+            bulk_scale: 3.0 * p.bulk_scale,
+            ..p
+        },
+    )
+    .unwrap();
+    for (ya, yb) in a.y.iter().zip(&b.y) {
+        assert!(
+            (ya - yb).abs() <= 1e-5 * unconfined_flow::H_L,
+            "{ya} vs {yb}"
+        );
+    }
+}
+
+/// Scene 12 at reduced size: the injection breaks the rock down above the minimum
+/// stress, the fracture grows along the maximum compression, and the mass balance
+/// closes to 1e-12 at every sample.
+#[test]
+fn injection_fracture_grows_along_the_maximum_stress() {
+    let o = injection::run(&cpu(), &injection::Params::reduced()).unwrap();
+    eprintln!(
+        "injection: p_b {:.3e} length {:.3} width {:.3} balance {:.1e} steps {}",
+        o.breakdown, o.length, o.width, o.balance, o.steps
+    );
+    assert!(o.length >= 0.1, "the fracture grew: {}", o.length);
+    assert!(
+        o.orientation() <= injection::ORIENTATION_TOL,
+        "{} / {}",
+        o.width,
+        o.length
+    );
+    assert!(o.min_stress_over_breakdown() < 1.0, "p_b {}", o.breakdown);
+    assert!(o.balance <= injection::BALANCE_TOL, "balance {}", o.balance);
+    // The injected volume is the rate times the time, to rounding.
+    let (t, v) = (o.history.column(0), o.history.column(2));
+    let last = t.len() - 1;
+    assert!((v[last] - injection::RATE * t[last]).abs() <= 1e-9 * v[last]);
 }

@@ -146,17 +146,27 @@ pub fn channel_flux(npc: usize, k: f64, grad: &[[f64; 3]; 3], psi: &[f64; 3]) ->
 
 /// Volume shares of one channel over a step of `dt`: `share[k]` is the net volume (m³)
 /// flowing into its node `k` (eq. 82 corrected, antisymmetric edge by edge). `psi` are
-/// the piezometric pressures of its nodes (Pa), `k_dt` = δ³ f(s̄) Δt/(12 μ_d).
+/// the piezometric pressures of its nodes (Pa), `k_dt` = δ³ Δt/(12 μ_d), `fw` the
+/// saturation weights f(s) of its nodes (eq. 81): each edge carries the weight of its
+/// upstream node (\[CORRECTED\], see [`upstream_weight`]).
 #[inline]
-pub fn channel_shares(npc: usize, k_dt: f64, w: &[f64; 3], psi: &[f64; 3]) -> [f64; 3] {
+pub fn channel_shares(
+    npc: usize,
+    k_dt: f64,
+    w: &[f64; 3],
+    psi: &[f64; 3],
+    fw: &[f64; 3],
+) -> [f64; 3] {
     let mut share = [0.0; 3];
     if npc == 2 {
         let q = k_dt * w[0] * (psi[0] - psi[1]);
+        let q = q * upstream_weight(q, fw[0], fw[1]);
         share[0] = -q;
         share[1] = q;
     } else {
         for (e, &(i, j, _)) in EDGES3.iter().enumerate() {
             let q = k_dt * w[e] * (psi[i] - psi[j]);
+            let q = q * upstream_weight(q, fw[i], fw[j]);
             share[i] -= q;
             share[j] += q;
         }
@@ -164,8 +174,25 @@ pub fn channel_shares(npc: usize, k_dt: f64, w: &[f64; 3], psi: &[f64; 3]) -> [f
     share
 }
 
+/// The saturation weight of an edge's flow `q` from its node i to its node j (before the
+/// weight): that of the node it leaves (`f_i` if q > 0, else `f_j`).
+/// \[CORRECTED\] The manual weights a channel by the mean saturation of its nodes
+/// (eq. 80), which lets a dry node go on draining at half the saturated rate into a wet
+/// one below it, below empty, so a free surface never settles (validation scene 10);
+/// upstream weighting, the standard for unsaturated flow, stops the outflow of an empty
+/// node and is the same for saturated flow.
+#[inline]
+pub fn upstream_weight(q: f64, f_i: f64, f_j: f64) -> f64 {
+    if q > 0.0 {
+        f_i
+    } else {
+        f_j
+    }
+}
+
 /// δ³ f(s̄)/(12 μ_d) (m³/(Pa·s)): the cubic-law conductivity of a channel of aperture δ
-/// whose nodes have mean saturation `s_mean` (eq. 75, 80–81).
+/// whose nodes have mean saturation `s_mean` (eq. 75, 80–81), used for its output flux
+/// and leak-off (the volume shares weight each edge upstream, [`channel_shares`]).
 #[inline]
 pub fn conductivity(delta: f64, s_mean: f64, mu_d: f64) -> f64 {
     delta * delta * delta * saturation_weight(s_mean) / (12.0 * mu_d)
@@ -266,7 +293,7 @@ mod tests {
             prop_assume!(a > 1e-3);
             // ψ linear: ψ_k = grad·m_k; its in-plane gradient is grad minus its normal part.
             let psi: [f64; 3] = std::array::from_fn(|k| dot(grad, m[k]));
-            let share = channel_shares(3, 1.0, &w, &psi);
+            let share = channel_shares(3, 1.0, &w, &psi, &[1.0; 3]);
             let gt = sub(grad, [n[0] * dot(grad, n), n[1] * dot(grad, n), n[2] * dot(grad, n)]);
             for l in 0..3 {
                 // ∇N_l = n × (m_k − m_j) / (2A) for (l, j, k) counter-clockwise.
@@ -281,22 +308,33 @@ mod tests {
                 let scale = 1.0 + dot(grad, grad).sqrt();
                 prop_assert!((share[l] - expect).abs() <= 1e-9 * scale, "{l}: {} vs {expect}", share[l]);
             }
-            let flat = channel_shares(3, 1.0, &w, &[7.0; 3]);
+            let flat = channel_shares(3, 1.0, &w, &[7.0; 3], &[1.0; 3]);
             prop_assert!(flat.iter().all(|&s| s.abs() < 1e-12));
         }
 
         /// Shares are antisymmetric: they sum to zero (volume conserved), and a
         /// zero gradient gives zero flux, in 2D and 3D.
         #[test]
-        fn shares_conserve_volume(m in tri(), psi in prop::array::uniform3(-1e6f64..1e6), kdt in 0.0f64..1e-3) {
+        fn shares_conserve_volume(
+            m in tri(),
+            psi in prop::array::uniform3(-1e6f64..1e6),
+            kdt in 0.0f64..1e-3,
+            fw in prop::array::uniform3(0.0f64..=1.0),
+            dry in 0usize..3,
+        ) {
             for npc in [2, 3] {
                 let w = channel_shape(npc, &m, &[[0.0; 3]; 3]).weight;
-                let s = channel_shares(npc, kdt, &w, &psi);
+                let s = channel_shares(npc, kdt, &w, &psi, &fw);
                 let total: f64 = s.iter().sum();
                 let mag: f64 = s.iter().map(|x| x.abs()).sum();
                 prop_assert!(total.abs() <= 1e-14 * mag.max(1e-300));
-                let zero = channel_shares(npc, kdt, &w, &[psi[0]; 3]);
+                let zero = channel_shares(npc, kdt, &w, &[psi[0]; 3], &fw);
                 prop_assert!(zero.iter().all(|&x| x == 0.0));
+                // An empty node (f = 0) gives nothing, whatever the gradient.
+                let mut fe = fw;
+                fe[dry % npc] = 0.0;
+                let e = channel_shares(npc, kdt, &w, &psi, &fe);
+                prop_assert!(e[dry % npc] >= 0.0, "empty node lost {}", e[dry % npc]);
                 if npc == 2 {
                     // Flux from high to low: node 0 loses when ψ_0 > ψ_1.
                     prop_assert!(s[0] * (psi[0] - psi[1]) <= 0.0);

@@ -44,8 +44,12 @@
 //!   walls, integrated exactly over each step, weighted by f(s̄), subtracted from the
 //!   nodes' inflow as a volume (the printed eq. 88 adds a volume to a rate); see
 //!   [`LeakOff`].
+//! * **(80)** \[CORRECTED\] the volume shares weight each edge by f(s) of the node its
+//!   flow leaves (upstream), not the channel mean, so an empty node stops draining
+//!   ([`flow::upstream_weight`]); the output flux and leak-off keep f(s̄).
 //! * **Table 11** conditions: pressure, free surface (hydrostatic below the water level,
-//!   \[NOT IN MANUAL\] no condition above it) and flow rate, each constant or a time table.
+//!   \[NOT IN MANUAL\] a seepage face above it: p ≤ 0 held, outflow only) and flow rate,
+//!   each constant or a time table.
 //! * **Coupling (7.5.2)** \[NOT IN MANUAL: the integration rule\] the linear pressure on a
 //!   channel is integrated consistently over the joint's two faces, ∫ N_k p dA, and
 //!   applied along the midplane normal, equal and opposite.

@@ -16,7 +16,7 @@ use crate::fields::{
     FLOW_PRESSURE, FLOW_SATURATION, FLOW_STORED,
 };
 use crate::flow::{self, Geometry};
-use crate::model::FlowModel;
+use crate::model::{saturation_weight, FlowModel};
 use crate::network::Network;
 
 /// Channels (or flow nodes) per rayon block: many per task, as the engine's loops do.
@@ -60,7 +60,7 @@ enum Condition {
     /// Fluid pressure p (Pa).
     Pressure(Range, TimeValue),
     /// Free-surface (water level) elevation z_s (m): p = ρ_f |g| (z_s − z) where the node
-    /// lies below it, no condition above.
+    /// lies below it, a seepage face (p ≤ 0 held) above.
     Head(Range, TimeValue),
     /// Volumetric flow rate into the network (m³/s; per unit thickness in 2D), shared
     /// equally by the distinct flow nodes of the range.
@@ -298,7 +298,9 @@ impl Hydro {
 
     /// A free surface (water level) at elevation `z_s` (m, along −g; constant or a time
     /// table) over the nodes of `range` (table 11 `f-s`): the hydrostatic pressure
-    /// ρ_f |g| (z_s − z) where a node lies below it, no condition above. Needs
+    /// ρ_f |g| (z_s − z) where a node lies below it; above it, a seepage face
+    /// (\[NOT IN MANUAL\]: the face is open to the air, so fluid reaching it leaves at
+    /// atmospheric pressure, p ≤ 0 held, and none enters; a dry node stays dry). Needs
     /// [`Hydro::gravity`].
     pub fn head(mut self, range: Range, z_s: impl Into<TimeValue>) -> Self {
         self.conditions.push(Condition::Head(range, z_s.into()));
@@ -1130,11 +1132,12 @@ impl<D: Dim> Physics<D> for Hydro {
                     for i in 0..leak.len() {
                         let c = b * CHUNK + i;
                         let fnodes = &net.channel_nodes[c * npc..(c + 1) * npc];
-                        let mut psi = [0.0; 3];
+                        let (mut psi, mut fw) = ([0.0; 3], [0.0; 3]);
                         let (mut s_mean, mut p_mean) = (0.0, 0.0);
                         for k in 0..npc {
                             let l = fnodes[k] as usize;
                             psi[k] = p[l] - rho * geom.gravity_potential[c * npc + k];
+                            fw[k] = saturation_weight(s[l]);
                             s_mean += s[l];
                             p_mean += p[l];
                         }
@@ -1143,7 +1146,8 @@ impl<D: Dim> Physics<D> for Hydro {
                         let k = flow::conductivity(geom.aperture[c], s_mean, mu);
                         let w: &[f64; 3] =
                             geom.weight[c * 3..c * 3 + 3].try_into().expect("3 weights");
-                        let sh = flow::channel_shares(npc, k * dt, w, &psi);
+                        let kdt = flow::conductivity(geom.aperture[c], 1.0, mu) * dt;
+                        let sh = flow::channel_shares(npc, kdt, w, &psi, &fw);
                         let mut grad = [[0.0; 3]; 3];
                         for j in 0..npc {
                             grad[j][..dd].copy_from_slice(
@@ -1219,7 +1223,15 @@ impl<D: Dim> Physics<D> for Hydro {
                         let (head, _) = d.fixed_values[f as usize];
                         let held = if head {
                             let p_h = rho * g_abs * (fixed_now[f as usize] - d.elevation[l]);
-                            (p_h > 0.0).then_some(p_h)
+                            // Above the water level, a seepage face: the fluid may leave
+                            // at atmospheric pressure, none enters.
+                            if p_h > 0.0 {
+                                Some(p_h)
+                            } else if w0 + trial > v {
+                                Some(0.0)
+                            } else {
+                                None
+                            }
                         } else {
                             Some(fixed_now[f as usize].max(0.0))
                         };

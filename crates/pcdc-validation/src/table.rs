@@ -16,8 +16,8 @@ use pcdc_compute::{Backend, BackendKind, Precision};
 use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
-    block_sliding, brazilian, direct_tension, fracture_flow, kirsch, ucs, vibration_energy,
-    wave_speed,
+    block_sliding, brazilian, direct_tension, fracture_flow, injection, kirsch, ucs,
+    unconfined_flow, vibration_energy, wave_speed,
 };
 
 /// One measured row of the report.
@@ -115,6 +115,8 @@ pub const CASES: &[&str] = &[
     "ucs",
     "brazilian",
     "fracture_flow",
+    "unconfined_flow",
+    "injection",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -205,6 +207,16 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("fracture_flow", "3d", size));
             }
         }
+        "unconfined_flow" => {
+            for size in unconfined_flow::SIZES {
+                out.push(j("unconfined_flow", "free surface", size));
+            }
+        }
+        "injection" => {
+            for size in [0.04, 0.03, injection::Params::full().size] {
+                out.push(j("injection", "mass balance", size));
+            }
+        }
         _ => {}
     }
     out
@@ -257,6 +269,42 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
             // The flow channels are the unknowns of this scene: they fill the elements
             // column.
             within(o.channels, o.error, fracture_flow::TOL, o.steps)
+        }
+        "unconfined_flow" => {
+            let o = unconfined_flow::run(backend, &unconfined_flow::Params::sized(job.size))?;
+            row(
+                o.channels,
+                o.error,
+                format!(
+                    "{} % (discharge off by {:.2} %)",
+                    unconfined_flow::TOL * 100.0,
+                    o.discharge_error * 100.0
+                ),
+                o.error <= unconfined_flow::TOL,
+                o.steps,
+            )
+        }
+        "injection" => {
+            let p = injection::Params {
+                size: job.size,
+                ..injection::Params::full()
+            };
+            let o = injection::run(backend, &p)?;
+            row(
+                o.elements,
+                o.balance,
+                format!(
+                    "{:e}; width/length ≤ {:.2} (measured {:.3}), p_b > |σ_min| (p_b {:.2} MPa)",
+                    injection::BALANCE_TOL,
+                    injection::ORIENTATION_TOL,
+                    o.orientation(),
+                    o.breakdown * 1e-6
+                ),
+                o.balance <= injection::BALANCE_TOL
+                    && o.orientation() <= injection::ORIENTATION_TOL
+                    && o.min_stress_over_breakdown() < 1.0,
+                o.steps,
+            )
         }
         "wave_speed" => {
             let p = wave_speed::Params { size: job.size };
@@ -401,7 +449,11 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
          peak neck stress against Ts, signed; ucs: Young's modulus from 20–50 % of the \
          peak against the input E, with UCS/Ts in the tolerance column; brazilian: \
          2P/(πD) / Ts − 1; fracture_flow: largest |p − p_exact| / p_A at x = L/2 and L, \
-         its elements column counting flow channels). Wall time includes the build; \
+         its elements column counting flow channels; unconfined_flow: largest |y − y_Dupuit| \
+         / h_l of the free surface, elements column counting flow channels, the discharge \
+         against Dupuit–Charny in the tolerance column; injection: mass-balance residual, \
+         relative, with the fracture's orientation and breakdown pressure in the tolerance \
+         column). Wall time includes the build; \
          element-steps/s = elements × steps / wall time (the direct Kirsch solve counts \
          its iterations as steps). GPU rows on a software adapter (Mesa's lavapipe) \
          show that the path works and what it costs there, not GPU speed.\n\n",

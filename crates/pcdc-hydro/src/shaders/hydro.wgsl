@@ -11,6 +11,12 @@
 
 const NONE: u32 = 0xffffffffu;
 
+// f(s) = s²(3 − 2s), s clamped to [0, 1] (eq. 81).
+fn sat_weight(s: Real) -> Real {
+    let sc = clamp(s, Real(0.0), Real(1.0));
+    return sc * sc * (3.0 - 2.0 * sc);
+}
+
 fn dot3(a: array<Real, 3>, b: array<Real, 3>) -> Real {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
@@ -144,31 +150,36 @@ fn kernel(c: u32) {
     let dt = p_dt() * FIELD_DT_SCALE;
     let r = c * INFO + 2u * NPC;
     var psi: array<Real, 3>;
+    var fw: array<Real, 3>;
     var s_mean = Real(0.0);
     var p_mean = Real(0.0);
     for (var k = 0u; k < NPC; k = k + 1u) {
         let l = hy_info[r + k];
         psi[k] = flow_pressure[l] - RHO * hy_gpot[c * NPC + k];
+        fw[k] = sat_weight(flow_saturation[l]);
         s_mean = s_mean + flow_saturation[l];
         p_mean = p_mean + flow_pressure[l];
     }
     s_mean = s_mean * INV_NPC;
     p_mean = p_mean * INV_NPC;
-    let sc = clamp(s_mean, Real(0.0), Real(1.0));
-    let fs = sc * sc * (3.0 - 2.0 * sc);
+    let fs = sat_weight(s_mean);
     let delta = channel_aperture[c];
-    let k = delta * delta * delta * fs / (12.0 * MU);
-    let kdt = k * dt;
+    let k_full = delta * delta * delta / (12.0 * MU);
+    let k = k_full * fs;
+    // Each edge carries the saturation weight of the node its flow leaves.
+    let kdt = k_full * dt;
     var share: array<Real, 3>;
     if NPC == 2u {
-        let q = kdt * hy_weight[c * 3u] * (psi[0] - psi[1]);
+        let q0 = kdt * hy_weight[c * 3u] * (psi[0] - psi[1]);
+        let q = q0 * select(fw[1], fw[0], q0 > 0.0);
         share[0] = -q;
         share[1] = q;
     } else {
         for (var e = 0u; e < 3u; e = e + 1u) {
             let i = e;
             let j = (e + 1u) % 3u;
-            let q = kdt * hy_weight[c * 3u + e] * (psi[i] - psi[j]);
+            let q0 = kdt * hy_weight[c * 3u + e] * (psi[i] - psi[j]);
+            let q = q0 * select(fw[j], fw[i], q0 > 0.0);
             share[i] = share[i] - q;
             share[j] = share[j] + q;
         }
@@ -237,6 +248,11 @@ fn kernel(l: u32) {
         if kind == 2u {
             ph = RHO * G_ABS * (value - hy_elev[l]);
             held = ph > 0.0;
+            // Above the water level, a seepage face: no pressure above atmospheric.
+            if !held && w0 + trial > v {
+                ph = Real(0.0);
+                held = true;
+            }
         } else {
             ph = max(value, Real(0.0));
             held = true;
