@@ -233,3 +233,53 @@ fn results_do_not_depend_on_the_unit_system() {
     assert!(p_si.iter().any(|&x| x > 0.1));
     assert!(worst < 1e-9, "p/p_A differs by {worst}");
 }
+
+/// Above a water level the face is a seepage face: a saturated node there is held at
+/// p = 0 and its excess leaves (booked as outflow), a dry one stays dry; below it the
+/// pressure is hydrostatic.
+#[test]
+fn water_level_has_a_seepage_face_above_it() {
+    let mesh = split_nodes(
+        &builders::rectangle(0.0, 0.0, 0.4, 0.2, 0.05).unwrap(),
+        &Range::All,
+    )
+    .unwrap();
+    let model = FlowModel::new(Fluid::water(), Aperture::fixed(1e-4).unwrap());
+    let level = 0.05;
+    let flow = Hydro::new(model)
+        .coupling(Coupling::FlowOnly)
+        .gravity([0.0, -9.81, 0.0])
+        .bulk_modulus_scale(1e-4)
+        .initial_pressure(3e3)
+        .head(Range::rect(0.39, -0.01, 0.41, 0.21), level);
+    let mut sim = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+        .physics(flow)
+        .build()
+        .unwrap();
+    sim.run(200).unwrap();
+    let set = sim.entity_set("flow_nodes").unwrap();
+    let p = sim.field(FLOW_PRESSURE).unwrap();
+    let s = sim.field(FLOW_SATURATION).unwrap();
+    let mut above = 0;
+    for l in 0..set.len() {
+        let x = sim.mesh().node(set.entity(l)[0] as usize);
+        if x[0] > 0.39 {
+            if x[1] > level + 1e-9 {
+                above += 1;
+                assert_eq!(p[l], 0.0, "seepage node at {x:?}");
+                assert!(s[l] <= 1.0);
+            } else {
+                let hydro = 1000.0 * 9.81 * (level - x[1]);
+                assert!(
+                    (p[l] - hydro).abs() <= 1e-9 * hydro.max(1.0),
+                    "{} vs {hydro}",
+                    p[l]
+                );
+            }
+        }
+    }
+    assert_eq!(above, 3);
+    let b = mass_balance(&sim).unwrap();
+    assert!(b.boundary < 0.0, "the block drained: {b:?}");
+    assert!(b.relative().abs() < 1e-12, "{b:?}");
+}

@@ -124,6 +124,31 @@ fn unsaturated_seepage_with_gravity_matches_cpu() {
     compare::<Dim2>(make, 400, 1e-12, Precision::F64);
 }
 
+/// A saturated block under pressure draining through a seepage face above a low water
+/// level (outflow at p = 0) and through the water level below it.
+#[test]
+fn seepage_face_matches_cpu() {
+    let make = |backend| {
+        let mesh = split_nodes(
+            &builders::rectangle(0.0, 0.0, 0.4, 0.2, 0.05).unwrap(),
+            &Range::All,
+        )
+        .unwrap();
+        let model = FlowModel::new(Fluid::water(), Aperture::fixed(1e-4).unwrap());
+        let flow = Hydro::new(model)
+            .coupling(Coupling::FlowOnly)
+            .gravity([0.0, -9.81, 0.0])
+            .bulk_modulus_scale(1e-4)
+            .initial_pressure(3e3)
+            .head(Range::rect(0.39, -0.01, 0.41, 0.21), 0.05);
+        Simulation::builder(mesh, backend)
+            .physics(flow)
+            .build()
+            .unwrap()
+    };
+    compare::<Dim2>(make, 400, 1e-12, Precision::F64);
+}
+
 #[test]
 fn two_way_injection_with_joints_and_leak_off_matches_cpu() {
     let make = |backend| {
