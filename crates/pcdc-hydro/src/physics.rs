@@ -587,35 +587,14 @@ impl Hydro {
                 for i in 0..measure.len() {
                     let c = b * CHUNK + i;
                     let nodes = &jn[c * 2 * npc..(c + 1) * 2 * npc];
-                    let mut mid = [[0.0; 3]; 3];
-                    let mut gap = [[0.0; 3]; 3];
-                    for k in 0..npc {
-                        let (xa, xb) = if follows {
-                            (
-                                kin.position(nodes[k] as usize),
-                                kin.position(nodes[npc + k] as usize),
-                            )
-                        } else {
-                            let mut xa = [0.0; 3];
-                            let mut xb = [0.0; 3];
-                            xa[..dd].copy_from_slice(kin.mesh.node(nodes[k] as usize));
-                            xb[..dd].copy_from_slice(kin.mesh.node(nodes[npc + k] as usize));
-                            (xa, xb)
-                        };
-                        for q in 0..3 {
-                            mid[k][q] = 0.5 * (xa[q] + xb[q]);
-                            gap[k][q] = xb[q] - xa[q];
-                        }
-                        gpot[i * npc + k] = g[0] * mid[k][0] + g[1] * mid[k][1] + g[2] * mid[k][2];
-                    }
-                    let sh = flow::channel_shape(npc, &mid, &gap);
-                    measure[i] = sh.measure;
-                    aperture[i] = flow::aperture_of(&model, delta0[c], sh.opening, follows);
-                    weight[i * 3..i * 3 + 3].copy_from_slice(&sh.weight);
-                    for k in 0..npc {
-                        grad[(i * npc + k) * dd..(i * npc + k + 1) * dd]
-                            .copy_from_slice(&sh.grad[k][..dd]);
-                    }
+                    let out = ChannelGeometryOut {
+                        measure: &mut measure[i],
+                        aperture: &mut aperture[i],
+                        weight: &mut weight[i * 3..i * 3 + 3],
+                        gpot: &mut gpot[i * npc..(i + 1) * npc],
+                        grad: &mut grad[i * npc * dd..(i + 1) * npc * dd],
+                    };
+                    channel_geometry(kin, nodes, npc, follows, &model, delta0[c], g, out);
                 }
             });
         let inv = 1.0 / npc as f64;
@@ -807,6 +786,76 @@ fn unit_up(g: [f64; 3]) -> [f64; 3] {
         [-g[0] / n, -g[1] / n, -g[2] / n]
     } else {
         [0.0; 3]
+    }
+}
+
+/// Every mesh node's pore pressure from its flow node (0 off the network), in parallel.
+fn copy_pore(mesh_flow: &[u32], p: &[f64], pore: &mut [f64]) {
+    pore.par_chunks_mut(4 * CHUNK)
+        .zip(mesh_flow.par_chunks(4 * CHUNK))
+        .for_each(|(pore, flow)| {
+            for (x, &f) in pore.iter_mut().zip(flow) {
+                *x = if f == Network::NONE {
+                    0.0
+                } else {
+                    p[f as usize]
+                };
+            }
+        });
+}
+
+/// Where [`channel_geometry`] writes one channel's geometry.
+struct ChannelGeometryOut<'a> {
+    measure: &'a mut f64,
+    aperture: &'a mut f64,
+    weight: &'a mut [f64],
+    gpot: &'a mut [f64],
+    grad: &'a mut [f64],
+}
+
+/// One channel's geometry from the positions of its joint's `nodes` (side A, then side
+/// B): measure, aperture (eq. 79), edge weights, gravity potential and gradients. The
+/// one arithmetic of the geometry pass and of the fused channel pass.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn channel_geometry<D: Dim>(
+    kin: &Kinematics<'_, D>,
+    nodes: &[u32],
+    npc: usize,
+    follows: bool,
+    model: &crate::model::Aperture,
+    delta0: f64,
+    g: [f64; 3],
+    out: ChannelGeometryOut<'_>,
+) {
+    let dd = D::D;
+    let mut mid = [[0.0; 3]; 3];
+    let mut gap = [[0.0; 3]; 3];
+    for k in 0..npc {
+        let (xa, xb) = if follows {
+            (
+                kin.position(nodes[k] as usize),
+                kin.position(nodes[npc + k] as usize),
+            )
+        } else {
+            let mut xa = [0.0; 3];
+            let mut xb = [0.0; 3];
+            xa[..dd].copy_from_slice(kin.mesh.node(nodes[k] as usize));
+            xb[..dd].copy_from_slice(kin.mesh.node(nodes[npc + k] as usize));
+            (xa, xb)
+        };
+        for q in 0..3 {
+            mid[k][q] = 0.5 * (xa[q] + xb[q]);
+            gap[k][q] = xb[q] - xa[q];
+        }
+        out.gpot[k] = g[0] * mid[k][0] + g[1] * mid[k][1] + g[2] * mid[k][2];
+    }
+    let sh = flow::channel_shape(npc, &mid, &gap);
+    *out.measure = sh.measure;
+    *out.aperture = flow::aperture_of(model, delta0, sh.opening, follows);
+    out.weight.copy_from_slice(&sh.weight);
+    for k in 0..npc {
+        out.grad[k * dd..(k + 1) * dd].copy_from_slice(&sh.grad[k][..dd]);
     }
 }
 
@@ -1030,13 +1079,7 @@ impl<D: Dim> Physics<D> for Hydro {
             return Ok(());
         }
         let [p, pore] = ctx.fields.get_many_mut([ids.pressure, ids.pore]);
-        for (n, &f) in net.mesh_flow.iter().enumerate() {
-            pore[n] = if f == Network::NONE {
-                0.0
-            } else {
-                p[f as usize]
-            };
-        }
+        copy_pore(&net.mesh_flow, p, pore);
         if self.coupling != Coupling::TwoWay {
             return Ok(());
         }
@@ -1091,91 +1134,128 @@ impl<D: Dim> Physics<D> for Hydro {
 
     fn field_step(&mut self, ctx: &mut FieldContext<'_, D>) -> Result<(), ComputeError> {
         let ids = self.ids.expect("init ran");
-        if ctx.substep == 0 && self.follows_solid() {
-            self.update_geometry(&ctx.kin);
-            ctx.fields
-                .get_mut(ids.aperture)
-                .copy_from_slice(&self.geom.aperture);
-        }
+        // The geometry follows the solid: rebuilt from the new positions in the channel
+        // pass (and the node volumes in the node pass) of the first fluid step after a
+        // mechanical one.
+        let fresh = ctx.substep == 0 && self.follows_solid();
         let dt = ctx.dt;
         let bulk = self.bulk_modulus();
         let mu = self.model.fluid.dynamic_viscosity();
         let rho = self.model.fluid.density;
         let d = self.derived.as_ref().expect("init ran");
         let (net, npc) = (&d.net, d.net.npc);
-        // Leak-off starts where a joint has broken since the last step.
-        if let Some(did) = ids.damage {
-            let [damage, age] = ctx.fields.get_many_mut([did, ids.leak_age]);
-            for (c, &j) in net.joint.iter().enumerate() {
-                if age[c] < 0.0 && damage[j as usize] >= 1.0 {
-                    age[c] = 0.0;
-                }
-            }
-        }
         // Channels: the volume each node gains over the step, and leak-off.
         {
-            let [p, s, leak_age, flux] =
-                ctx.fields
-                    .get_many_mut([ids.pressure, ids.saturation, ids.leak_age, ids.flux]);
+            let keys = [ids.pressure, ids.saturation, ids.leak_age, ids.flux];
+            let (p, s, leak_age, flux, damage) = match ids.damage {
+                Some(did) => {
+                    let [p, s, a, f, dmg] = ctx
+                        .fields
+                        .get_many_mut([keys[0], keys[1], keys[2], keys[3], did]);
+                    (p, s, a, f, Some(&*dmg))
+                }
+                None => {
+                    let [p, s, a, f] = ctx.fields.get_many_mut(keys);
+                    (p, s, a, f, None)
+                }
+            };
             let (p, s) = (&*p, &*s);
             let dd = D::D;
-            let geom = &self.geom;
             let leak_model = self.model.leak_off;
             let inv = 1.0 / npc as f64;
+            let (aperture_model, g, kin) = (self.model.aperture, self.gravity, &ctx.kin);
+            let (jn, delta0) = (&d.channel_joint_nodes, &d.delta0);
+            let geom = &mut self.geom;
             self.share
                 .par_chunks_mut(CHUNK * npc)
                 .zip(self.leak.par_chunks_mut(CHUNK))
                 .zip(flux.par_chunks_mut(CHUNK * dd))
                 .zip(leak_age.par_chunks_mut(CHUNK))
+                .zip(geom.measure.par_chunks_mut(CHUNK))
+                .zip(geom.aperture.par_chunks_mut(CHUNK))
+                .zip(geom.weight.par_chunks_mut(CHUNK * 3))
+                .zip(geom.gravity_potential.par_chunks_mut(CHUNK * npc))
+                .zip(geom.grad.par_chunks_mut(CHUNK * npc * dd))
                 .enumerate()
-                .for_each(|(b, (((share, leak), flux), age))| {
-                    for i in 0..leak.len() {
-                        let c = b * CHUNK + i;
-                        let fnodes = &net.channel_nodes[c * npc..(c + 1) * npc];
-                        let (mut psi, mut fw) = ([0.0; 3], [0.0; 3]);
-                        let (mut s_mean, mut p_mean) = (0.0, 0.0);
-                        for k in 0..npc {
-                            let l = fnodes[k] as usize;
-                            psi[k] = p[l] - rho * geom.gravity_potential[c * npc + k];
-                            fw[k] = saturation_weight(s[l]);
-                            s_mean += s[l];
-                            p_mean += p[l];
+                .for_each(
+                    |(
+                        b,
+                        (
+                            (((((((share, leak), flux), age), measure), aperture), weight), gpot),
+                            grad,
+                        ),
+                    )| {
+                        for i in 0..leak.len() {
+                            let c = b * CHUNK + i;
+                            if fresh {
+                                let out = ChannelGeometryOut {
+                                    measure: &mut measure[i],
+                                    aperture: &mut aperture[i],
+                                    weight: &mut weight[i * 3..i * 3 + 3],
+                                    gpot: &mut gpot[i * npc..(i + 1) * npc],
+                                    grad: &mut grad[i * npc * dd..(i + 1) * npc * dd],
+                                };
+                                let nodes = &jn[c * 2 * npc..(c + 1) * 2 * npc];
+                                channel_geometry(
+                                    kin,
+                                    nodes,
+                                    npc,
+                                    true,
+                                    &aperture_model,
+                                    delta0[c],
+                                    g,
+                                    out,
+                                );
+                            }
+                            // Leak-off starts where a joint has broken since the last step.
+                            if let Some(damage) = damage {
+                                if age[i] < 0.0 && damage[net.joint[c] as usize] >= 1.0 {
+                                    age[i] = 0.0;
+                                }
+                            }
+                            let fnodes = &net.channel_nodes[c * npc..(c + 1) * npc];
+                            let (mut psi, mut fw) = ([0.0; 3], [0.0; 3]);
+                            let (mut s_mean, mut p_mean) = (0.0, 0.0);
+                            for k in 0..npc {
+                                let l = fnodes[k] as usize;
+                                psi[k] = p[l] - rho * gpot[i * npc + k];
+                                fw[k] = saturation_weight(s[l]);
+                                s_mean += s[l];
+                                p_mean += p[l];
+                            }
+                            s_mean *= inv;
+                            p_mean *= inv;
+                            let k = flow::conductivity(aperture[i], s_mean, mu);
+                            let w: &[f64; 3] =
+                                weight[i * 3..i * 3 + 3].try_into().expect("3 weights");
+                            let kdt = flow::conductivity(aperture[i], 1.0, mu) * dt;
+                            let sh = flow::channel_shares(npc, kdt, w, &psi, &fw);
+                            let mut g3 = [[0.0; 3]; 3];
+                            for j in 0..npc {
+                                g3[j][..dd].copy_from_slice(
+                                    &grad[(i * npc + j) * dd..(i * npc + j + 1) * dd],
+                                );
+                            }
+                            let q = flow::channel_flux(npc, k, &g3, &psi);
+                            flux[i * dd..(i + 1) * dd].copy_from_slice(&q[..dd]);
+                            share[i * npc..(i + 1) * npc].copy_from_slice(&sh[..npc]);
+                            leak[i] = match &leak_model {
+                                Some(lm) => flow::leak_per_node(
+                                    lm, npc, measure[i], p_mean, s_mean, bulk, mu, age[i], dt,
+                                ),
+                                None => 0.0,
+                            };
+                            if age[i] >= 0.0 {
+                                age[i] += dt;
+                            }
                         }
-                        s_mean *= inv;
-                        p_mean *= inv;
-                        let k = flow::conductivity(geom.aperture[c], s_mean, mu);
-                        let w: &[f64; 3] =
-                            geom.weight[c * 3..c * 3 + 3].try_into().expect("3 weights");
-                        let kdt = flow::conductivity(geom.aperture[c], 1.0, mu) * dt;
-                        let sh = flow::channel_shares(npc, kdt, w, &psi, &fw);
-                        let mut grad = [[0.0; 3]; 3];
-                        for j in 0..npc {
-                            grad[j][..dd].copy_from_slice(
-                                &geom.grad[(c * npc + j) * dd..(c * npc + j + 1) * dd],
-                            );
-                        }
-                        let q = flow::channel_flux(npc, k, &grad, &psi);
-                        flux[i * dd..(i + 1) * dd].copy_from_slice(&q[..dd]);
-                        share[i * npc..(i + 1) * npc].copy_from_slice(&sh[..npc]);
-                        leak[i] = match &leak_model {
-                            Some(lm) => flow::leak_per_node(
-                                lm,
-                                npc,
-                                geom.measure[c],
-                                p_mean,
-                                s_mean,
-                                bulk,
-                                mu,
-                                age[i],
-                                dt,
-                            ),
-                            None => 0.0,
-                        };
-                        if age[i] >= 0.0 {
-                            age[i] += dt;
-                        }
-                    }
-                });
+                    },
+                );
+        }
+        if fresh {
+            ctx.fields
+                .get_mut(ids.aperture)
+                .copy_from_slice(&self.geom.aperture);
         }
         // Flow nodes: content, conditions, pressure and saturation. Conditions take their
         // value at the end of the mechanical step (every sub-step of it alike, as the GPU
@@ -1193,19 +1273,30 @@ impl<D: Dim> Physics<D> for Hydro {
         let [w, p, s, bal] =
             ctx.fields
                 .get_many_mut([ids.content, ids.pressure, ids.saturation, ids.balance]);
-        let (share, leak, vol) = (&self.share, &self.leak, &self.geom.node_volume);
+        let (share, leak) = (&self.share, &self.leak);
+        let geom = &mut self.geom;
+        let (measure, aperture) = (&geom.measure, &geom.aperture);
+        let inv = 1.0 / npc as f64;
         w.par_chunks_mut(CHUNK)
             .zip(p.par_chunks_mut(CHUNK))
             .zip(s.par_chunks_mut(CHUNK))
             .zip(bal.par_chunks_mut(CHUNK * 4))
+            .zip(geom.node_volume.par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(b, (((w, p), s), bal))| {
+            .for_each(|(b, ((((w, p), s), bal), vol))| {
                 for i in 0..w.len() {
                     let l = b * CHUNK + i;
-                    let (mut gain, mut lost) = (0.0, 0.0);
+                    let (mut gain, mut lost, mut volume) = (0.0, 0.0, 0.0);
                     for &e in &net.incidence[net.inc_ptr[l] as usize..net.inc_ptr[l + 1] as usize] {
                         gain += share[e as usize];
                         lost += leak[e as usize / npc];
+                        if fresh {
+                            let c = e as usize / npc;
+                            volume += measure[c] * aperture[c] * inv;
+                        }
+                    }
+                    if fresh {
+                        vol[i] = volume;
                     }
                     // The change since the start, so that the balance sums changes, not
                     // contents (no cancellation against the stored volume).
@@ -1216,7 +1307,7 @@ impl<D: Dim> Physics<D> for Hydro {
                     let trial = w[i] + gain - lost + inject;
                     bal[i * 4 + 1] += inject;
                     bal[i * 4 + 3] += lost;
-                    let (v, w0) = (vol[l], bal[i * 4]);
+                    let (v, w0) = (vol[i], bal[i * 4]);
                     let mut next = trial;
                     let f = d.fixed[l];
                     if f != Network::NONE {
@@ -1259,13 +1350,7 @@ impl<D: Dim> Physics<D> for Hydro {
         }
         if self.coupling == Coupling::FlowOnly {
             let [p, pore] = ctx.fields.get_many_mut([ids.pressure, ids.pore]);
-            for (n, &f) in net.mesh_flow.iter().enumerate() {
-                pore[n] = if f == Network::NONE {
-                    0.0
-                } else {
-                    p[f as usize]
-                };
-            }
+            copy_pore(&net.mesh_flow, p, pore);
         }
         Ok(())
     }
