@@ -587,13 +587,8 @@ impl Hydro {
                 for i in 0..measure.len() {
                     let c = b * CHUNK + i;
                     let nodes = &jn[c * 2 * npc..(c + 1) * 2 * npc];
-                    let out = ChannelGeometryOut {
-                        measure: &mut measure[i],
-                        aperture: &mut aperture[i],
-                        weight: &mut weight[i * 3..i * 3 + 3],
-                        gpot: &mut gpot[i * npc..(i + 1) * npc],
-                        grad: &mut grad[i * npc * dd..(i + 1) * npc * dd],
-                    };
+                    let out =
+                        ChannelGeometryOut::at(i, npc, dd, measure, aperture, weight, gpot, grad);
                     channel_geometry(kin, nodes, npc, follows, &model, delta0[c], g, out);
                 }
             });
@@ -811,6 +806,30 @@ struct ChannelGeometryOut<'a> {
     weight: &'a mut [f64],
     gpot: &'a mut [f64],
     grad: &'a mut [f64],
+}
+
+impl<'a> ChannelGeometryOut<'a> {
+    /// Channel `i` of chunks of the geometry arrays (`npc` nodes, dimension `dd`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn at(
+        i: usize,
+        npc: usize,
+        dd: usize,
+        measure: &'a mut [f64],
+        aperture: &'a mut [f64],
+        weight: &'a mut [f64],
+        gpot: &'a mut [f64],
+        grad: &'a mut [f64],
+    ) -> Self {
+        ChannelGeometryOut {
+            measure: &mut measure[i],
+            aperture: &mut aperture[i],
+            weight: &mut weight[i * 3..i * 3 + 3],
+            gpot: &mut gpot[i * npc..(i + 1) * npc],
+            grad: &mut grad[i * npc * dd..(i + 1) * npc * dd],
+        }
+    }
 }
 
 /// One channel's geometry from the positions of its joint's `nodes` (side A, then side
@@ -1188,13 +1207,9 @@ impl<D: Dim> Physics<D> for Hydro {
                         for i in 0..leak.len() {
                             let c = b * CHUNK + i;
                             if fresh {
-                                let out = ChannelGeometryOut {
-                                    measure: &mut measure[i],
-                                    aperture: &mut aperture[i],
-                                    weight: &mut weight[i * 3..i * 3 + 3],
-                                    gpot: &mut gpot[i * npc..(i + 1) * npc],
-                                    grad: &mut grad[i * npc * dd..(i + 1) * npc * dd],
-                                };
+                                let out = ChannelGeometryOut::at(
+                                    i, npc, dd, measure, aperture, weight, gpot, grad,
+                                );
                                 let nodes = &jn[c * 2 * npc..(c + 1) * 2 * npc];
                                 channel_geometry(
                                     kin,
