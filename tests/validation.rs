@@ -50,16 +50,16 @@ fn fracture_flow_within_5_percent_of_pa_2d_and_3d() {
     }
 }
 
-/// Scene 9 in 2D within its 2 % tolerance. The 3D variant misses it (5.5 % at this size,
-/// 3.0 % at the full one: a known limit of the face network, see
-/// `scenes::radial_flow::run_3d`); its bound here only guards against a regression.
+/// Scene 9 within its 2 % tolerance in 2D and 3D (1.2 % in 3D at this size, whose
+/// calibrated edge weights make the face network the finite-element discretisation of
+/// Darcy flow on the tetrahedra).
 #[test]
-fn radial_flow_within_2_percent_in_2d_and_bounded_in_3d() {
+fn radial_flow_within_2_percent_in_2d_and_3d() {
     let (cpu, p) = (cpu(), radial_flow::Params::reduced());
     let o2 = radial_flow::run_2d(&cpu, &p).unwrap();
     assert!(o2.error <= radial_flow::TOL, "2d: {}", o2.error);
     let o3 = radial_flow::run_3d(&cpu, &p).unwrap();
-    assert!(o3.error <= 0.06, "3d: {}", o3.error);
+    assert!(o3.error <= radial_flow::TOL, "3d: {}", o3.error);
     for o in [&o2, &o3] {
         assert!(o.balance.abs() < 1e-9, "balance {}", o.balance);
     }

@@ -68,6 +68,14 @@ impl Hydro {
         let info = setup.upload("hydro channel info", GpuData::U32(info));
         let joint_of = setup.upload("hydro channel joint", GpuData::U32(net.joint.clone()));
         let delta0 = setup.upload("hydro initial aperture", GpuData::Real(d.delta0.clone()));
+        let delta_ref = setup.upload(
+            "hydro reference aperture",
+            GpuData::Real(d.delta_ref.clone()),
+        );
+        let calib = setup.upload(
+            "hydro calibrated weights",
+            GpuData::Real(d.calib_weight.clone()),
+        );
         let inc_ptr = setup.upload("hydro incidence ptr", GpuData::U32(net.inc_ptr.clone()));
         let inc = setup.upload("hydro incidence", GpuData::U32(net.incidence.clone()));
         let mesh_flow = setup.upload(
@@ -188,6 +196,8 @@ impl Hydro {
                     ("disp", disp, R),
                     ("hy_info", info, R),
                     ("hy_delta0", delta0, R),
+                    ("hy_delta_ref", delta_ref, R),
+                    ("hy_calib", calib, R),
                     ("hy_measure", measure, W),
                     ("hy_weight", weight, W),
                     ("hy_gpot", gpot, W),
@@ -288,11 +298,8 @@ impl Hydro {
                 ("pore_pressure", pore, W),
             ],
         );
-        if follows {
-            setup.kernel(Phase::Forces, pore_k)?;
-        } else {
-            setup.kernel(Phase::Field, pore_k)?;
-        }
+        // The pore pressure changes only with the fluid step: copied after it.
+        setup.kernel(Phase::Field, pore_k)?;
         if self.coupling == Coupling::TwoWay {
             let k = consts(Kernel::new(
                 "hydro pressure forces",

@@ -47,6 +47,11 @@
 //! * **(80)** \[CORRECTED\] the volume shares weight each edge by f(s) of the node its
 //!   flow leaves (upstream), not the channel mean, so an empty node stops draining
 //!   ([`flow::upstream_weight`]); the output flux and leak-off keep f(s̄).
+//! * **Intact rock** \[NOT IN MANUAL: the manual says the virtual aperture is
+//!   calibrated, not how\] with [`Hydro::rock_permeability`] the intact network is the
+//!   linear finite-element discretisation of isotropic Darcy flow: through one aperture
+//!   per edge in 2D, through calibrated edge weights per face in 3D, blending into the
+//!   cubic law of the joint's own geometry as it opens ([`calibration`]).
 //! * **Table 11** conditions: pressure, free surface (hydrostatic below the water level,
 //!   \[NOT IN MANUAL\] a seepage face above it: p ≤ 0 held, outflow only) and flow rate,
 //!   each constant or a time table.
@@ -60,7 +65,7 @@
 //! (Gershgorin on the nodal Laplacian). In flow-only mode this bound is taken at the
 //! fixed apertures; when the flow follows the solid, at the aperture range's worst case,
 //! min_c 12 μ_d A_c / (N K_f δ_max² Σ_j |w_kj|) (so δ_max bounds the step, as the manual
-//! says). In two-way coupling the fluid stiffens the joints by about K_f/δ per unit face
+//! says; with calibrated weights the larger of δ_r² |ŵ| and its value at δ_max). In two-way coupling the fluid stiffens the joints by about K_f/δ per unit face
 //! area; the mechanical step is limited accordingly (at δ_min), and
 //! [`Hydro::bulk_modulus_scale`] trades transient accuracy for speed. Both are reported
 //! with the limiting flow node or channel (`Simulation::time_step_limit`,
@@ -76,6 +81,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod balance;
+pub mod calibration;
 pub mod fields;
 pub mod flow;
 mod gpu;

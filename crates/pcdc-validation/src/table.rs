@@ -16,7 +16,7 @@ use pcdc_compute::{Backend, BackendKind, Precision};
 use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
-    block_sliding, brazilian, direct_tension, fracture_flow, injection, kirsch, ucs,
+    block_sliding, brazilian, direct_tension, fracture_flow, injection, kirsch, radial_flow, ucs,
     unconfined_flow, vibration_energy, wave_speed,
 };
 
@@ -114,6 +114,7 @@ pub const CASES: &[&str] = &[
     "direct_tension",
     "ucs",
     "brazilian",
+    "radial_flow",
     "fracture_flow",
     "unconfined_flow",
     "injection",
@@ -200,6 +201,12 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("brazilian", "2P/(πD) vs Ts", size));
             }
         }
+        "radial_flow" => {
+            for size in radial_flow::SIZES {
+                out.push(j("radial_flow", "2d", size));
+                out.push(j("radial_flow", "3d", size));
+            }
+        }
         "fracture_flow" => {
             let s = fracture_flow::Params::full().size;
             for size in [4.0 * s, 2.0 * s, s] {
@@ -269,6 +276,15 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
             // The flow channels are the unknowns of this scene: they fill the elements
             // column.
             within(o.channels, o.error, fracture_flow::TOL, o.steps)
+        }
+        "radial_flow" => {
+            let p = radial_flow::Params { size: job.size };
+            let o = if job.variant == "2d" {
+                radial_flow::run_2d(backend, &p)?
+            } else {
+                radial_flow::run_3d(backend, &p)?
+            };
+            within(o.channels, o.error, radial_flow::TOL, o.steps)
         }
         "unconfined_flow" => {
             let o = unconfined_flow::run(backend, &unconfined_flow::Params::sized(job.size))?;
@@ -448,7 +464,9 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
          vibration_energy: energy drift; block_sliding: stopping distance; direct_tension: \
          peak neck stress against Ts, signed; ucs: Young's modulus from 20–50 % of the \
          peak against the input E, with UCS/Ts in the tolerance column; brazilian: \
-         2P/(πD) / Ts − 1; fracture_flow: largest |p − p_exact| / p_A at x = L/2 and L, \
+         2P/(πD) / Ts − 1; radial_flow: largest |p − p_exact| / (p_i − p_o) over every flow \
+         node, its elements column counting flow channels; fracture_flow: largest \
+         |p − p_exact| / p_A at x = L/2 and L, \
          its elements column counting flow channels; unconfined_flow: largest |y − y_Dupuit| \
          / h_l of the free surface, elements column counting flow channels, the discharge \
          against Dupuit–Charny in the tolerance column; injection: mass-balance residual, \

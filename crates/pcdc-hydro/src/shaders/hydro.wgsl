@@ -113,9 +113,18 @@ fn kernel(c: u32) {
     }
     let sh = channel_shape(mid, gap);
     hy_measure[c] = sh.measure;
-    channel_aperture[c] = clamp(hy_delta0[c] + sh.opening, DMIN, DMAX);
+    let delta = clamp(hy_delta0[c] + sh.opening, DMIN, DMAX);
+    channel_aperture[c] = delta;
+    // Calibrated channels blend from their calibrated weights to their own as they open.
+    var beta = Real(0.0);
+    let dr = hy_delta_ref[c];
+    if (dr > 0.0) {
+        let r = min(dr / delta, Real(1.0));
+        beta = r * r * r;
+    }
     for (var e = 0u; e < 3u; e = e + 1u) {
-        hy_weight[c * 3u + e] = sh.weight[e];
+        let w = sh.weight[e];
+        hy_weight[c * 3u + e] = w + beta * (hy_calib[c * 3u + e] - w);
     }
     for (var k = 0u; k < NPC; k = k + 1u) {
         for (var q = 0u; q < D; q = q + 1u) {
