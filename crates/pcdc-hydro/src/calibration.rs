@@ -29,7 +29,7 @@ use std::collections::HashMap;
 
 use pcdc_mesh::{Dim, Mesh};
 
-use crate::flow::EDGES3;
+use crate::flow::{cross, dot, sub, EDGES3};
 use crate::network::Network;
 
 /// The virtual aperture of joint `j` for rock mass permeability `k`: 2D, the exact one
@@ -182,25 +182,6 @@ pub fn blend(weight: &mut [f64], calibrated: &[f64], delta_ref: f64, delta: f64)
     for (w, &h) in weight.iter_mut().zip(calibrated) {
         *w += beta * (h - *w);
     }
-}
-
-#[inline]
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline]
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 #[inline]

@@ -670,6 +670,7 @@ impl Hydro {
                         .enumerate()
                         .take(if npc == 2 { 1 } else { 3 })
                 {
+                    // Calibrated channels are 3D only (gradient stride 3).
                     let w = if dr > 0.0 {
                         let gi = &geom.grad[(c * npc + i) * 3..(c * npc + i + 1) * 3];
                         let gj = &geom.grad[(c * npc + j) * 3..(c * npc + j + 1) * 3];
