@@ -16,6 +16,9 @@ use pcdc_mech::{Boundary, FaceStress, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, split_nodes, Dim2, Range};
 
 const STEPS: u64 = 10;
+/// Steps run before the injection scene is timed, with and without its fluid alike (the
+/// fracture has started in the coupled run).
+const WARM: u64 = 2000;
 
 fn scene(size: f64, flow: Option<Coupling>, threads: usize) -> Simulation<Dim2> {
     let mesh = split_nodes(
@@ -56,7 +59,7 @@ fn scene(size: f64, flow: Option<Coupling>, threads: usize) -> Simulation<Dim2> 
 }
 
 /// Validation scene 12's set-up (`pcdc_validation::scenes::injection`), with or without
-/// its fluid, after `warm` steps (the fracture has started).
+/// its fluid, after `warm` steps.
 fn injection(size: f64, fluid: bool, threads: usize, warm: u64) -> Simulation<Dim2> {
     let mesh = split_nodes(&builders::disc([0.0, 0.0], 0.5, size).unwrap(), &Range::All).unwrap();
     let stress = [-8e6, -4e6, 0.0, 0.0, 0.0, 0.0];
@@ -116,13 +119,13 @@ fn bench_injection(c: &mut Criterion) {
     g.sample_size(10);
     for (name, size) in [("4k", 0.02), ("16k", 0.01)] {
         for threads in [1, 2] {
-            let mut mech = injection(size, false, threads, 0);
+            let mut mech = injection(size, false, threads, WARM);
             let n = mech.mesh().n_elements() as u64;
             g.throughput(Throughput::Elements(n * STEPS));
             g.bench_function(format!("disc_{name}_mechanics_threads_{threads}"), |b| {
                 b.iter(|| mech.run(STEPS).unwrap())
             });
-            let mut sim = injection(size, true, threads, 2000);
+            let mut sim = injection(size, true, threads, WARM);
             let channels = sim.entity_set("flow_channels").unwrap().len() as u64;
             if threads == 1 {
                 eprintln!(

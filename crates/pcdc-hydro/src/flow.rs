@@ -78,9 +78,12 @@ pub fn channel_shape(npc: usize, mid: &[[f64; 3]; 3], gap: &[[f64; 3]; 3]) -> Sh
         let len = (dx * dx + dy * dy).sqrt();
         sh.measure = len;
         if len > 0.0 {
-            sh.normal = [dy / len, -dx / len, 0.0];
-            sh.weight[0] = 1.0 / len;
-            let t = [dx / (len * len), dy / (len * len), 0.0];
+            // One division: the square root and the divisions after it were half of
+            // the channel pass (a dependent chain).
+            let inv = 1.0 / len;
+            sh.normal = [dy * inv, -dx * inv, 0.0];
+            sh.weight[0] = inv;
+            let t = [dx * (inv * inv), dy * (inv * inv), 0.0];
             sh.grad[0] = [-t[0], -t[1], 0.0];
             sh.grad[1] = t;
         }
@@ -91,15 +94,17 @@ pub fn channel_shape(npc: usize, mid: &[[f64; 3]; 3], gap: &[[f64; 3]; 3]) -> Sh
         let twice = dot(c, c).sqrt();
         sh.measure = 0.5 * twice;
         if twice > 0.0 {
-            let n = [c[0] / twice, c[1] / twice, c[2] / twice];
+            let inv = 1.0 / twice;
+            let n = [c[0] * inv, c[1] * inv, c[2] * inv];
             sh.normal = n;
+            let half = 0.5 * inv;
             for (e, &(i, j, k)) in EDGES3.iter().enumerate() {
-                sh.weight[e] = dot(sub(mid[i], mid[k]), sub(mid[j], mid[k])) / (2.0 * twice);
+                sh.weight[e] = dot(sub(mid[i], mid[k]), sub(mid[j], mid[k])) * half;
             }
             for k in 0..3 {
                 let e = sub(mid[(k + 2) % 3], mid[(k + 1) % 3]);
                 let g = cross(n, e);
-                sh.grad[k] = [g[0] / twice, g[1] / twice, g[2] / twice];
+                sh.grad[k] = [g[0] * inv, g[1] * inv, g[2] * inv];
             }
         }
     }
@@ -110,25 +115,16 @@ pub fn channel_shape(npc: usize, mid: &[[f64; 3]; 3], gap: &[[f64; 3]; 3]) -> Sh
     sh
 }
 
-/// Measure and unit normal of a channel from its midplane points: the same arithmetic as
-/// [`channel_shape`], without the rest (the pressure forces need only these).
+/// The area vector A n of a channel from its midplane points (m in 2D, m² in 3D; n the
+/// unit normal from side A to side B): (Δy, −Δx) of the segment in 2D, half the cross
+/// product in 3D; zero on a degenerate channel. The pressure forces need only this.
 #[inline]
-pub fn measure_normal(npc: usize, mid: &[[f64; 3]; 3]) -> (f64, [f64; 3]) {
+pub fn area_normal(npc: usize, mid: &[[f64; 3]; 3]) -> [f64; 3] {
     if npc == 2 {
-        let (dx, dy) = (mid[1][0] - mid[0][0], mid[1][1] - mid[0][1]);
-        let len = (dx * dx + dy * dy).sqrt();
-        if len > 0.0 {
-            return (len, [dy / len, -dx / len, 0.0]);
-        }
-        return (len, [0.0; 3]);
+        return [mid[1][1] - mid[0][1], -(mid[1][0] - mid[0][0]), 0.0];
     }
     let c = cross(sub(mid[1], mid[0]), sub(mid[2], mid[0]));
-    let twice = dot(c, c).sqrt();
-    if twice > 0.0 {
-        (0.5 * twice, [c[0] / twice, c[1] / twice, c[2] / twice])
-    } else {
-        (0.5 * twice, [0.0; 3])
-    }
+    [0.5 * c[0], 0.5 * c[1], 0.5 * c[2]]
 }
 
 /// The mean flux q = −k ∇ψ of a channel (m²/s: volume per unit time and unit width), with

@@ -21,7 +21,7 @@ use crate::model::{saturation_weight, FlowModel};
 use crate::network::Network;
 
 /// Channels (or flow nodes) per rayon block: many per task, as the engine's loops do.
-const CHUNK: usize = 2048;
+const CHUNK: usize = 256;
 
 /// How the fluid and the solid exchange information (manual 7.5.2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -581,7 +581,7 @@ impl Hydro {
     /// configuration, or the reference one in flow-only mode).
     fn update_geometry<D: Dim>(&mut self, kin: &Kinematics<'_, D>) {
         let d = self.derived.as_ref().expect("init ran");
-        let (net, npc, dd) = (&d.net, d.net.npc, D::D);
+        let (net, npc, dd) = (&d.net, D::NODES_PER_FACE, D::D);
         let jn = &d.channel_joint_nodes;
         let follows = self.follows_solid();
         let model = self.model.aperture;
@@ -608,7 +608,7 @@ impl Hydro {
                     let out =
                         ChannelGeometryOut::at(i, npc, dd, measure, aperture, weight, gpot, grad);
                     let calib = (d.delta_ref[c], &d.calib_weight[c * 3..c * 3 + 3]);
-                    channel_geometry(kin, nodes, npc, follows, &model, delta0[c], calib, g, out);
+                    channel_geometry(kin, nodes, follows, &model, delta0[c], calib, g, out);
                 }
             });
         let inv = 1.0 / npc as f64;
@@ -837,7 +837,6 @@ impl<'a> ChannelGeometryOut<'a> {
 fn channel_geometry<D: Dim>(
     kin: &Kinematics<'_, D>,
     nodes: &[u32],
-    npc: usize,
     follows: bool,
     model: &crate::model::Aperture,
     delta0: f64,
@@ -845,7 +844,8 @@ fn channel_geometry<D: Dim>(
     g: [f64; 3],
     out: ChannelGeometryOut<'_>,
 ) {
-    let dd = D::D;
+    // Compile-time sizes, so that the per-node loops unroll.
+    let (dd, npc) = (D::D, D::NODES_PER_FACE);
     let mut mid = [[0.0; 3]; 3];
     let mut gap = [[0.0; 3]; 3];
     for k in 0..npc {
@@ -1092,7 +1092,7 @@ impl<D: Dim> Physics<D> for Hydro {
     fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let ids = self.ids.expect("init ran");
         let d = self.derived.as_ref().expect("init ran");
-        let (net, npc, dd) = (&d.net, d.net.npc, D::D);
+        let (net, npc, dd) = (&d.net, D::NODES_PER_FACE, D::D);
         // The pore pressure is copied after each fluid step (it changes only there).
         if self.coupling != Coupling::TwoWay {
             return Ok(());
@@ -1118,7 +1118,10 @@ impl<D: Dim> Physics<D> for Hydro {
                             mid[k][q] = 0.5 * (xa[q] + xb[q]);
                         }
                     }
-                    let (a, n) = flow::measure_normal(npc, &mid);
+                    // A n (area times unit normal, side A to side B) without the
+                    // square root: the rotated segment in 2D, half the cross product
+                    // in 3D (zero on a degenerate channel, as the unit normal is).
+                    let an = flow::area_normal(npc, &mid);
                     let pk: [f64; 3] = std::array::from_fn(|k| {
                         if k < npc {
                             p[net.channel_nodes[c * npc + k] as usize]
@@ -1131,14 +1134,14 @@ impl<D: Dim> Physics<D> for Hydro {
                         // Consistent integration of the linear pressure over the face:
                         // ∫ N_k p dA = A (p_k + Σ p)/6 (2D) or /12 (3D).
                         let f = if npc == 2 {
-                            a * (2.0 * pk[k] + pk[1 - k]) / 6.0
+                            (2.0 * pk[k] + pk[1 - k]) / 6.0
                         } else {
-                            a * (pk[k] + pk[0] + pk[1] + pk[2]) / 12.0
+                            (pk[k] + pk[0] + pk[1] + pk[2]) / 12.0
                         };
                         for q in 0..dd {
                             // Side A pushed against the normal (A to B), side B along it.
-                            out[k * dd + q] = -f * n[q];
-                            out[(npc + k) * dd + q] = f * n[q];
+                            out[k * dd + q] = -f * an[q];
+                            out[(npc + k) * dd + q] = f * an[q];
                         }
                     }
                 }
@@ -1157,7 +1160,7 @@ impl<D: Dim> Physics<D> for Hydro {
         let mu = self.model.fluid.dynamic_viscosity();
         let rho = self.model.fluid.density;
         let d = self.derived.as_ref().expect("init ran");
-        let (net, npc) = (&d.net, d.net.npc);
+        let (net, npc) = (&d.net, D::NODES_PER_FACE);
         // Channels: the volume each node gains over the step, and leak-off.
         {
             let keys = [ids.pressure, ids.saturation, ids.leak_age, ids.flux];
@@ -1209,7 +1212,6 @@ impl<D: Dim> Physics<D> for Hydro {
                                 channel_geometry(
                                     kin,
                                     nodes,
-                                    npc,
                                     true,
                                     &aperture_model,
                                     delta0[c],

@@ -50,10 +50,12 @@ fn channel_shape(mid: array<array<Real, 3>, 3>, gap: array<array<Real, 3>, 3>) -
         let len = sqrt(dx * dx + dy * dy);
         sh.measure = len;
         if len > 0.0 {
-            sh.normal = array<Real, 3>(dy / len, -dx / len, Real(0.0));
-            sh.weight[0] = 1.0 / len;
-            let t0 = dx / (len * len);
-            let t1 = dy / (len * len);
+            // One division (as `flow::channel_shape`).
+            let inv = 1.0 / len;
+            sh.normal = array<Real, 3>(dy * inv, -dx * inv, Real(0.0));
+            sh.weight[0] = inv;
+            let t0 = dx * (inv * inv);
+            let t1 = dy * (inv * inv);
             sh.grad[0] = array<Real, 3>(-t0, -t1, Real(0.0));
             sh.grad[1] = array<Real, 3>(t0, t1, Real(0.0));
         }
@@ -64,15 +66,17 @@ fn channel_shape(mid: array<array<Real, 3>, 3>, gap: array<array<Real, 3>, 3>) -
         let twice = sqrt(dot3(c, c));
         sh.measure = 0.5 * twice;
         if twice > 0.0 {
-            let n = array<Real, 3>(c[0] / twice, c[1] / twice, c[2] / twice);
+            let inv = 1.0 / twice;
+            let n = array<Real, 3>(c[0] * inv, c[1] * inv, c[2] * inv);
             sh.normal = n;
             // Edges (0,1), (1,2), (2,0) with opposite vertices 2, 0, 1.
-            sh.weight[0] = dot3(sub3(mid[0], mid[2]), sub3(mid[1], mid[2])) / (2.0 * twice);
-            sh.weight[1] = dot3(sub3(mid[1], mid[0]), sub3(mid[2], mid[0])) / (2.0 * twice);
-            sh.weight[2] = dot3(sub3(mid[2], mid[1]), sub3(mid[0], mid[1])) / (2.0 * twice);
+            let half = 0.5 * inv;
+            sh.weight[0] = dot3(sub3(mid[0], mid[2]), sub3(mid[1], mid[2])) * half;
+            sh.weight[1] = dot3(sub3(mid[1], mid[0]), sub3(mid[2], mid[0])) * half;
+            sh.weight[2] = dot3(sub3(mid[2], mid[1]), sub3(mid[0], mid[1])) * half;
             for (var k = 0u; k < 3u; k = k + 1u) {
                 let g = cross3(n, sub3(mid[(k + 2u) % 3u], mid[(k + 1u) % 3u]));
-                sh.grad[k] = array<Real, 3>(g[0] / twice, g[1] / twice, g[2] / twice);
+                sh.grad[k] = array<Real, 3>(g[0] * inv, g[1] * inv, g[2] * inv);
             }
         }
     }
@@ -306,7 +310,14 @@ fn kernel(c: u32) {
     var mid: array<array<Real, 3>, 3>;
     var gap: array<array<Real, 3>, 3>;
     channel_points(c, &mid, &gap);
-    let sh = channel_shape(mid, gap);
+    // A n without the square root, as `flow::area_normal`.
+    var an: array<Real, 3>;
+    if NPC == 2u {
+        an = array<Real, 3>(mid[1][1] - mid[0][1], -(mid[1][0] - mid[0][0]), Real(0.0));
+    } else {
+        let cr = cross3(sub3(mid[1], mid[0]), sub3(mid[2], mid[0]));
+        an = array<Real, 3>(0.5 * cr[0], 0.5 * cr[1], 0.5 * cr[2]);
+    }
     let r = c * INFO + 2u * NPC;
     var pk: array<Real, 3>;
     for (var k = 0u; k < NPC; k = k + 1u) {
@@ -316,13 +327,13 @@ fn kernel(c: u32) {
     for (var k = 0u; k < NPC; k = k + 1u) {
         var f = Real(0.0);
         if NPC == 2u {
-            f = sh.measure * (2.0 * pk[k] + pk[1u - k]) / 6.0;
+            f = (2.0 * pk[k] + pk[1u - k]) / 6.0;
         } else {
-            f = sh.measure * (pk[k] + pk[0] + pk[1] + pk[2]) / 12.0;
+            f = (pk[k] + pk[0] + pk[1] + pk[2]) / 12.0;
         }
         for (var q = 0u; q < D; q = q + 1u) {
-            slots[s0 + k * D + q] = -f * sh.normal[q];
-            slots[s0 + (NPC + k) * D + q] = f * sh.normal[q];
+            slots[s0 + k * D + q] = -f * an[q];
+            slots[s0 + (NPC + k) * D + q] = f * an[q];
         }
     }
 }
