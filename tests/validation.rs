@@ -242,8 +242,8 @@ fn unconfined_flow_follows_dupuit_whatever_the_bulk_modulus_scale() {
 fn injection_fracture_grows_along_the_maximum_stress() {
     let o = injection::run(&cpu(), &injection::Params::reduced()).unwrap();
     eprintln!(
-        "injection: p_b {:.3e} length {:.3} width {:.3} balance {:.1e} steps {}",
-        o.breakdown, o.length, o.width, o.balance, o.steps
+        "injection: p_b {:.3e} (sampled {:.3e}) length {:.3} width {:.3} balance {:.1e} steps {}",
+        o.breakdown, o.sampled_peak, o.length, o.width, o.balance, o.steps
     );
     assert!(o.length >= 0.1, "the fracture grew: {}", o.length);
     assert!(
@@ -253,6 +253,13 @@ fn injection_fracture_grows_along_the_maximum_stress() {
         o.length
     );
     assert!(o.min_stress_over_breakdown() < 1.0, "p_b {}", o.breakdown);
+    // The peak over every fluid step is at least the highest sample.
+    assert!(
+        o.breakdown >= o.sampled_peak,
+        "{} < {}",
+        o.breakdown,
+        o.sampled_peak
+    );
     assert!(o.balance <= injection::BALANCE_TOL, "balance {}", o.balance);
     // The injected volume is the rate times the time, to rounding.
     let (t, v) = (o.history.column(0), o.history.column(2));

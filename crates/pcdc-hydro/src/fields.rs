@@ -25,6 +25,14 @@ pub const FLOW_PRESSURE: FieldKey = FieldKey::new(
     Place::Set(FLOW_NODES),
     Components::Fixed(1),
 );
+/// The highest pressure each flow node has reached since the start (Pa), updated at
+/// every fluid step: at an injection node, the breakdown pressure, whatever the output
+/// interval.
+pub const FLOW_PEAK_PRESSURE: FieldKey = FieldKey::new(
+    "flow_peak_pressure",
+    Place::Set(FLOW_NODES),
+    Components::Fixed(1),
+);
 /// Saturation s of each flow node (-, in [0, 1]).
 pub const FLOW_SATURATION: FieldKey = FieldKey::new(
     "flow_saturation",

@@ -11,8 +11,8 @@ use pcdc_compute::ComputeError;
 use pcdc_mesh::Dim;
 
 use crate::fields::{
-    CHANNEL_APERTURE, CHANNEL_FLUX, CHANNEL_LEAK_AGE, FLOW_BALANCE, FLOW_PRESSURE, FLOW_SATURATION,
-    FLOW_STORED,
+    CHANNEL_APERTURE, CHANNEL_FLUX, CHANNEL_LEAK_AGE, FLOW_BALANCE, FLOW_PEAK_PRESSURE,
+    FLOW_PRESSURE, FLOW_SATURATION, FLOW_STORED,
 };
 use crate::network::Network;
 use crate::physics::{Coupling, Hydro};
@@ -160,6 +160,7 @@ impl Hydro {
         };
         let f = |key| setup.field(key);
         let (aperture, flux, age) = (f(CHANNEL_APERTURE)?, f(CHANNEL_FLUX)?, f(CHANNEL_LEAK_AGE)?);
+        let peak = f(FLOW_PEAK_PRESSURE)?;
         let (pressure, saturation, stored, balance, pore) = (
             f(FLOW_PRESSURE)?,
             f(FLOW_SATURATION)?,
@@ -279,6 +280,7 @@ impl Hydro {
                 ("flow_stored", stored, W),
                 ("flow_balance", balance, W),
                 ("flow_pressure", pressure, W),
+                ("flow_peak_pressure", peak, W),
                 ("flow_saturation", saturation, W),
                 ("status", status, W),
             ],

@@ -1,6 +1,6 @@
 //! Output of the flow network for ParaView: its own `.vtu`/`.pvd` series (line cells in
 //! 2D, triangle cells in 3D, at the flow nodes' current positions) with pressure,
-//! saturation and content on the points and aperture and flux on the cells. The solid's
+//! peak pressure, saturation and content on the points and aperture and flux on the cells. The solid's
 //! series can carry the pressure of every mesh node from
 //! [`pcdc_compute::names::PORE_PRESSURE`].
 
@@ -12,8 +12,8 @@ use pcdc_mesh::vtu::{Cells, DataArray, PvdSeries, VTK_LINE, VTK_TRIANGLE};
 use pcdc_mesh::Dim;
 
 use crate::fields::{
-    CHANNEL_APERTURE, CHANNEL_FLUX, FLOW_BALANCE, FLOW_CHANNELS, FLOW_NODES, FLOW_PRESSURE,
-    FLOW_SATURATION, FLOW_STORED,
+    CHANNEL_APERTURE, CHANNEL_FLUX, FLOW_BALANCE, FLOW_CHANNELS, FLOW_NODES, FLOW_PEAK_PRESSURE,
+    FLOW_PRESSURE, FLOW_SATURATION, FLOW_STORED,
 };
 
 /// The network's points (current positions of the flow nodes, stride D) and its
@@ -78,6 +78,7 @@ impl NetworkSeries {
             cell_type: if D::D == 2 { VTK_LINE } else { VTK_TRIANGLE },
         };
         let p = sim.field(FLOW_PRESSURE)?;
+        let peak = sim.field(FLOW_PEAK_PRESSURE)?;
         let s = sim.field(FLOW_SATURATION)?;
         let (dw, bal) = (sim.field(FLOW_STORED)?, sim.field(FLOW_BALANCE)?);
         let w: Vec<f64> = dw.iter().enumerate().map(|(l, x)| bal[4 * l] + x).collect();
@@ -90,6 +91,10 @@ impl NetworkSeries {
                 DataArray::Scalar {
                     name: "pressure",
                     values: p,
+                },
+                DataArray::Scalar {
+                    name: "peak_pressure",
+                    values: peak,
                 },
                 DataArray::Scalar {
                     name: "saturation",

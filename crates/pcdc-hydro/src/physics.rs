@@ -14,7 +14,7 @@ use pcdc_mesh::{Dim, Mesh, Range};
 use crate::calibration;
 use crate::fields::{
     CHANNEL_APERTURE, CHANNEL_FLUX, CHANNEL_LEAK_AGE, FLOW_BALANCE, FLOW_CHANNELS, FLOW_NODES,
-    FLOW_PRESSURE, FLOW_SATURATION, FLOW_STORED,
+    FLOW_PEAK_PRESSURE, FLOW_PRESSURE, FLOW_SATURATION, FLOW_STORED,
 };
 use crate::flow::{self, Geometry};
 use crate::model::{saturation_weight, FlowModel};
@@ -82,6 +82,7 @@ enum Selection {
 struct Ids {
     content: FieldId,
     pressure: FieldId,
+    peak: FieldId,
     saturation: FieldId,
     balance: FieldId,
     aperture: FieldId,
@@ -912,6 +913,7 @@ impl<D: Dim> Physics<D> for Hydro {
         let mut f = vec![
             FLOW_STORED.own::<D>(),
             FLOW_PRESSURE.own::<D>(),
+            FLOW_PEAK_PRESSURE.own::<D>(),
             FLOW_SATURATION.own::<D>().initial(1.0),
             FLOW_BALANCE.own::<D>(),
             CHANNEL_APERTURE.own::<D>(),
@@ -935,6 +937,7 @@ impl<D: Dim> Physics<D> for Hydro {
         let ids = Ids {
             content: fields.id(FLOW_STORED)?,
             pressure: fields.id(FLOW_PRESSURE)?,
+            peak: fields.id(FLOW_PEAK_PRESSURE)?,
             saturation: fields.id(FLOW_SATURATION)?,
             balance: fields.id(FLOW_BALANCE)?,
             aperture: fields.id(CHANNEL_APERTURE)?,
@@ -1030,6 +1033,7 @@ impl<D: Dim> Physics<D> for Hydro {
         for l in 0..nf {
             bal[l * 4] = content[l];
         }
+        ctx.fields.get_mut(ids.peak).copy_from_slice(&p0);
         let pore = ctx.fields.get_mut(ids.pore);
         for (n, &f) in d.net.mesh_flow.iter().enumerate() {
             pore[n] = if f == Network::NONE {
@@ -1283,20 +1287,25 @@ impl<D: Dim> Physics<D> for Hydro {
             values.split_at(d.fixed_values.len())
         };
         let g_abs = self.gravity.iter().map(|g| g * g).sum::<f64>().sqrt();
-        let [w, p, s, bal] =
-            ctx.fields
-                .get_many_mut([ids.content, ids.pressure, ids.saturation, ids.balance]);
+        let [w, p, peak, s, bal] = ctx.fields.get_many_mut([
+            ids.content,
+            ids.pressure,
+            ids.peak,
+            ids.saturation,
+            ids.balance,
+        ]);
         let (share, leak) = (&self.share, &self.leak);
         let geom = &mut self.geom;
         let (measure, aperture) = (&geom.measure, &geom.aperture);
         let inv = 1.0 / npc as f64;
         w.par_chunks_mut(CHUNK)
             .zip(p.par_chunks_mut(CHUNK))
+            .zip(peak.par_chunks_mut(CHUNK))
             .zip(s.par_chunks_mut(CHUNK))
             .zip(bal.par_chunks_mut(CHUNK * 4))
             .zip(geom.node_volume.par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(b, ((((w, p), s), bal), vol))| {
+            .for_each(|(b, (((((w, p), peak), s), bal), vol))| {
                 for i in 0..w.len() {
                     let l = b * CHUNK + i;
                     let (mut gain, mut lost, mut volume) = (0.0, 0.0, 0.0);
@@ -1347,6 +1356,7 @@ impl<D: Dim> Physics<D> for Hydro {
                     w[i] = next;
                     let (pn, sn) = flow::state_of(w0 + next, v, bulk);
                     p[i] = pn;
+                    peak[i] = peak[i].max(pn);
                     s[i] = sn;
                 }
             });

@@ -2,8 +2,8 @@
 //! faces equal and opposite, injection opens them, and volume is conserved.
 
 use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams};
-use pcdc_compute::{Backend, Simulation};
-use pcdc_hydro::fields::CHANNEL_APERTURE;
+use pcdc_compute::{Backend, Simulation, SubCycle, Table};
+use pcdc_hydro::fields::{CHANNEL_APERTURE, FLOW_PEAK_PRESSURE, FLOW_PRESSURE};
 use pcdc_hydro::{mass_balance, Aperture, FlowModel, Fluid, Hydro};
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, split_nodes, Dim2, Mesh, Range};
@@ -148,5 +148,56 @@ fn injection_opens_joints_and_conserves_volume() {
     assert!(
         widest > 1e-5,
         "the pressure opened a joint: widest {widest} (limit {limit:?}, {stage:?})"
+    );
+}
+
+#[test]
+fn peak_pressure_is_the_maximum_over_every_fluid_step() {
+    const SCALE: f64 = 1e-3;
+    // Injection for the first 100 steps' worth of time, then none while the ends drain:
+    // the pressure rises and falls, and the peak must keep its highest value, not the
+    // last nor one seen only at an output interval. K_f is scaled so far down that the
+    // fluid steps no more often than the solid (every fluid step is seen here).
+    let probe = Simulation::builder(block(), Backend::cpu(1).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(joints(1e7))
+        .physics(Hydro::new(model()).bulk_modulus_scale(SCALE))
+        .build()
+        .unwrap();
+    let stop = 100.0 * probe.dt();
+    let rate = Table::new("rate", &[(0.0, 2e-6), (stop, 2e-6), (1.01 * stop, 0.0)]).unwrap();
+    let flow = Hydro::new(model())
+        .bulk_modulus_scale(SCALE)
+        .rate(Range::rect(0.099, 0.039, 0.101, 0.041), rate)
+        .pressure(Range::group("left"), 0.0)
+        .pressure(Range::group("right"), 0.0);
+    let mut sim = Simulation::builder(block(), Backend::cpu(2).unwrap())
+        .physics(Mechanics::new().material(Range::All, rock()))
+        .physics(joints(1e7))
+        .physics(flow)
+        .build()
+        .unwrap();
+    let cycle = sim.field_stages()[0].cycle;
+    assert!(matches!(cycle, SubCycle::Every(_)), "{cycle:?}");
+    let mut seen = sim.field(FLOW_PRESSURE).unwrap().to_vec();
+    for _ in 0..600 {
+        sim.step().unwrap();
+        for (m, &p) in seen.iter_mut().zip(sim.field(FLOW_PRESSURE).unwrap()) {
+            *m = m.max(p);
+        }
+    }
+    let (p, peak) = (
+        sim.field(FLOW_PRESSURE).unwrap(),
+        sim.field(FLOW_PEAK_PRESSURE).unwrap(),
+    );
+    assert_eq!(peak, &seen[..]);
+    let fell = p
+        .iter()
+        .zip(peak)
+        .filter(|(p, m)| **p < 0.5 * **m && **m > 0.0)
+        .count();
+    assert!(
+        fell > 0,
+        "the pressure fell somewhere after the injection stopped"
     );
 }

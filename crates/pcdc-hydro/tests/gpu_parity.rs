@@ -3,7 +3,9 @@
 use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams};
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{Backend, Precision, Simulation};
-use pcdc_hydro::fields::{CHANNEL_APERTURE, CHANNEL_FLUX, FLOW_PRESSURE, FLOW_SATURATION};
+use pcdc_hydro::fields::{
+    CHANNEL_APERTURE, CHANNEL_FLUX, FLOW_PEAK_PRESSURE, FLOW_PRESSURE, FLOW_SATURATION,
+};
 use pcdc_hydro::{mass_balance, Aperture, Coupling, FlowModel, Fluid, Hydro, LeakOff};
 use pcdc_mech::{LinearElastic, Mechanics};
 use pcdc_mesh::{builders, split_nodes, Dim, Dim2, Mesh, Range};
@@ -44,6 +46,7 @@ fn compare<D: Dim>(make: impl Fn(Backend) -> Simulation<D>, steps: u64, tol: f64
     b.run(steps).unwrap();
     for f in [
         FLOW_PRESSURE,
+        FLOW_PEAK_PRESSURE,
         FLOW_SATURATION,
         CHANNEL_APERTURE,
         CHANNEL_FLUX,

@@ -285,6 +285,7 @@ fn kernel(l: u32) {
         s = max(w / v, Real(0.0));
     }
     flow_pressure[l] = p;
+    flow_peak_pressure[l] = max(flow_peak_pressure[l], p);
     flow_saturation[l] = s;
     if !(abs(p) <= REAL_MAX) {
         atomicMin(&status[2], ERR_DIVERGED);
