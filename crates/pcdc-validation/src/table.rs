@@ -77,10 +77,17 @@ impl Row {
 
     /// Parses a line written by [`Row::to_csv`].
     pub fn from_csv(line: &str) -> Option<Row> {
-        let f: Vec<&str> = line.split(',').collect();
-        if f.len() != 11 {
+        // The tolerance text may hold commas: it is everything between the seventh
+        // field and the last three.
+        let all: Vec<&str> = line.split(',').collect();
+        if all.len() < 11 {
             return None;
         }
+        let n = all.len();
+        let tol = all[7..n - 3].join(",");
+        let mut f: Vec<&str> = all[..7].to_vec();
+        f.push(&tol);
+        f.extend_from_slice(&all[n - 3..]);
         Some(Row {
             case: f[0].into(),
             variant: f[1].into(),
@@ -578,6 +585,10 @@ mod tests {
         assert_eq!(Row::from_csv(&r.to_csv()), Some(r.clone()));
         assert_eq!(r.element_steps_per_s(), 2e6);
         assert!(Row::from_csv("a,b,c").is_none());
+        // A tolerance text with commas (the injection scene's) survives the cache.
+        let mut r = row("injection", 1e-13);
+        r.tol = "1e-12; width/length ≤ 0.33 (measured 0.06), p_b 12 MPa".into();
+        assert_eq!(Row::from_csv(&r.to_csv()), Some(r));
     }
 
     #[test]
