@@ -27,6 +27,7 @@
 //! | eq. 15–16 | body force and lumped mass `ρV/(N+1)` per node | `Mechanics`, gravity in `Simulation` |
 //! | eq. 17–19 | viscous stress `σ_v = D_f C ε̇`, `C = 2L√(ρE)`, L = mean edge length | `Mechanics` |
 //! | eq. 20–24 | isotropic linear elasticity, λ and μ from E, ν (or K, G) | [`LinearElastic`] |
+//! | eq. 25–33 (29 \[CORRECTED\]), table 2 | Mohr–Coulomb with tension cut-off, non-associated shear flow, return mapping over the pyramid's planes, edges and the shear–tension corner | [`MohrCoulomb`], [`mohr_coulomb`], [`principal`] |
 //! | tables 4–7 | velocity/acceleration, force, face stress, move constraints | [`Boundary`] |
 //!
 //! The stable step of an element is `κ h / c_p` with h its smallest height, c_p the
@@ -124,10 +125,13 @@ mod error;
 pub mod kinematics;
 mod mechanics;
 mod model;
+pub mod mohr_coulomb;
 pub mod output;
+pub mod principal;
 
 pub use actions::{reset_displacement, reset_element_state, reset_velocity, set_velocity};
 pub use boundary::{Boundary, Components, Constraint, FaceStress, ACCEL_VELOCITY};
 pub use error::MechError;
 pub use mechanics::{Mechanics, SurfaceProperties};
 pub use model::{double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};
+pub use mohr_coulomb::MohrCoulomb;

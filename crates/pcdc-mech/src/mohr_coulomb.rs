@@ -1,0 +1,498 @@
+//! Mohr–Coulomb elasto-plasticity with a tension cut-off (manual 7.2.4, table 2,
+//! `mech-mohr-coulomb`).
+//!
+//! Principal stresses are ordered σ1 ≤ σ2 ≤ σ3, tension positive (σ1 the most
+//! compressive; FLAC's ordering, the only one consistent with eq. 29–30, see the digest).
+//! In 2D (plane strain) σzz is one of the three.
+//!
+//! * **(25)–(28)** elastic trial σ* = σ(t) + C:Δε, computed in Cartesian components and
+//!   then decomposed ([`crate::principal`]); in principal axes Δσ_i = α1 Δε_i + α2 Σ_{j≠i}
+//!   Δε_j, α1 = K + 4G/3, α2 = K − 2G/3.
+//! * **(29)** \[CORRECTED\] shear yield f_s = −σ1 + σ3 N_φ − 2c √N_φ (printed with N_φ where
+//!   √N_φ belongs); failure when f_s > 0.
+//! * **(30)** tension yield f_t = σ3 − σ_t; **(31)** N_φ = (1 + sin φ)/(1 − sin φ).
+//! * **(32)** shear potential g_s = −σ1 + σ3 N_ψ (non-associated, dilation angle ψ ≤ φ);
+//!   **(33)** tension potential g_t = σ3 (associated).
+//! * **Return mapping** \[NOT IN MANUAL: the manual stops at "correct with the potential"\]
+//!   σ^N = σ* − Σ_k λ_k D ∇g_k over an active set of the yield planes of the ordered
+//!   sector, λ_k ≥ 0 from f_k(σ^N) = 0 (the planes are linear in principal space, so each
+//!   set is one small linear solve). The planes: the shear plane of eq. 29, the two
+//!   shear planes that meet it where σ2 reaches σ3 or σ1 (the edges of the Mohr–Coulomb
+//!   pyramid), and σ_i = σ_t for each i. One shear plane alone is the digest's (FLAC's)
+//!   formula, λ = F / [α1(1 + N_φ N_ψ) − α2(N_φ + N_ψ)]; σ3 = σ_t alone is its tension
+//!   correction; the shear plane with σ3 = σ_t is the shear–tension corner; all three
+//!   tension planes the apex of the cut-off. The digest's h-function,
+//!   h = σ3 − σ_t + α_P(σ1 − σ_P), α_P = √(1 + N_φ²) + N_φ, σ_P = σ_t N_φ − 2c√N_φ,
+//!   orders the first two trials (shear first when h ≤ 0, tension first when h > 0); a
+//!   set is taken only if its multipliers are non-negative and the corrected stress lies
+//!   on or inside every plane (to rounding), so the result is never outside the yield
+//!   surface even where FLAC's single correction would leave σ2 above σ_t or the
+//!   principal order broken. Directions are those of the trial stress (isotropy).
+//! * **Tension cut-off cap** σ_t ≤ c / tan φ (digest 2.2): beyond it the cut-off would
+//!   not meet the shear pyramid, and with it the plastic dissipation σ:Δε^p ≥ 0.
+//!
+//! History per element ([`MohrCoulomb::n_state`], shown in VTU through the
+//! `model_state` field): `[0]` shear now, `[1]` shear in the past, `[2]` tension now,
+//! `[3]` tension in the past (1 or 0; "now" is this step, "past" any step since the last
+//! `reset_element_state`), `[4]` accumulated plastic shear strain κ_s (FLAC's measure,
+//! Δκ_s = √(½(Δε1ᵖ − Δεmᵖ)² + ½(Δεmᵖ)² + ½(Δε3ᵖ − Δεmᵖ)²), Δεmᵖ = (Δε1ᵖ + Δε3ᵖ)/3),
+//! `[5]` accumulated plastic tensile strain κ_t (the tension planes' multipliers summed).
+
+use serde::{Deserialize, Serialize};
+
+use crate::model::{add_hooke, ConstitutiveModel, LinearElastic, Sym6};
+use crate::principal::{compose, principal};
+use crate::MechError;
+
+/// Number of history variables of [`MohrCoulomb`].
+pub const MC_STATE: usize = 6;
+
+/// Index of the flags and strains in a [`MohrCoulomb`] element's history.
+pub mod state {
+    /// 1 when the element yielded in shear this step.
+    pub const SHEAR_NOW: usize = 0;
+    /// 1 when the element has yielded in shear since its state was last reset.
+    pub const SHEAR_PAST: usize = 1;
+    /// 1 when the element yielded in tension this step.
+    pub const TENSION_NOW: usize = 2;
+    /// 1 when the element has yielded in tension since its state was last reset.
+    pub const TENSION_PAST: usize = 3;
+    /// Accumulated plastic shear strain κ_s (-).
+    pub const SHEAR_STRAIN: usize = 4;
+    /// Accumulated plastic tensile strain κ_t (-).
+    pub const TENSION_STRAIN: usize = 5;
+}
+
+/// Mohr–Coulomb elasto-plastic model with a tension cut-off (manual 7.2.4, table 2).
+///
+/// Parameters (checked by the constructor and on deserialisation, errors name the
+/// parameter): the elastic part as a [`LinearElastic`] (E, ν, ρ, D_f, contact
+/// properties); cohesion c ≥ 0 (Pa); friction angle φ in [0, 90) degrees; dilation angle
+/// ψ in [0, φ] degrees; tensile strength σ_t ≥ 0 (Pa), capped at c / tan φ when φ > 0
+/// ([`MohrCoulomb::tensile_effective`]). With c = σ_t = 0 and φ = 0 the material has no
+/// strength at all, which is refused.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RawMohrCoulomb")]
+pub struct MohrCoulomb {
+    elastic: LinearElastic,
+    cohesion: f64,
+    friction: f64,
+    dilation: f64,
+    tensile: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMohrCoulomb {
+    elastic: LinearElastic,
+    cohesion: f64,
+    friction: f64,
+    #[serde(default)]
+    dilation: f64,
+    tensile: f64,
+}
+
+impl TryFrom<RawMohrCoulomb> for MohrCoulomb {
+    type Error = MechError;
+    fn try_from(r: RawMohrCoulomb) -> Result<Self, MechError> {
+        MohrCoulomb::new(r.elastic, r.cohesion, r.friction, r.dilation, r.tensile)
+    }
+}
+
+impl MohrCoulomb {
+    /// From the elastic part, cohesion c (Pa), friction angle φ (degrees), dilation angle
+    /// ψ (degrees) and tensile strength σ_t (Pa).
+    pub fn new(
+        elastic: LinearElastic,
+        cohesion: f64,
+        friction_deg: f64,
+        dilation_deg: f64,
+        tensile: f64,
+    ) -> Result<Self, MechError> {
+        if !(cohesion >= 0.0 && cohesion.is_finite()) {
+            return Err(MechError::param(
+                "cohesion c (cohesion)",
+                cohesion,
+                "must be non-negative and finite (Pa)",
+            ));
+        }
+        if !(0.0..90.0).contains(&friction_deg) {
+            return Err(MechError::param(
+                "friction angle φ (friction)",
+                friction_deg,
+                "must lie in [0, 90) degrees",
+            ));
+        }
+        if !(dilation_deg >= 0.0 && dilation_deg <= friction_deg) {
+            return Err(MechError::param(
+                "dilation angle ψ (dilation)",
+                dilation_deg,
+                format!("must lie in [0, φ = {friction_deg}] degrees"),
+            ));
+        }
+        if !(tensile >= 0.0 && tensile.is_finite()) {
+            return Err(MechError::param(
+                "tensile strength σ_t (tensile)",
+                tensile,
+                "must be non-negative and finite (Pa)",
+            ));
+        }
+        if cohesion == 0.0 && friction_deg == 0.0 {
+            return Err(MechError::param(
+                "cohesion c (cohesion)",
+                cohesion,
+                "and the friction angle are both zero: the material would have no shear \
+                 strength",
+            ));
+        }
+        Ok(MohrCoulomb {
+            elastic,
+            cohesion,
+            friction: friction_deg,
+            dilation: dilation_deg,
+            tensile,
+        })
+    }
+
+    /// The elastic part.
+    pub fn elastic(&self) -> &LinearElastic {
+        &self.elastic
+    }
+    /// Cohesion c (Pa).
+    pub fn cohesion(&self) -> f64 {
+        self.cohesion
+    }
+    /// Friction angle φ (degrees).
+    pub fn friction(&self) -> f64 {
+        self.friction
+    }
+    /// Dilation angle ψ (degrees).
+    pub fn dilation(&self) -> f64 {
+        self.dilation
+    }
+    /// Tensile strength σ_t as given (Pa).
+    pub fn tensile(&self) -> f64 {
+        self.tensile
+    }
+    /// The tensile strength the model uses: min(σ_t, c / tan φ) (Pa).
+    pub fn tensile_effective(&self) -> f64 {
+        let phi = self.friction.to_radians();
+        if phi > 0.0 {
+            self.tensile.min(self.cohesion / phi.tan())
+        } else {
+            self.tensile
+        }
+    }
+    /// Uniaxial compressive strength 2c √N_φ (Pa).
+    pub fn ucs(&self) -> f64 {
+        2.0 * self.cohesion * n_of(self.friction).sqrt()
+    }
+
+    /// The surfaces for the return mapping.
+    pub fn surfaces(&self) -> Surfaces {
+        let (g, k) = (self.elastic.shear(), self.elastic.bulk());
+        Surfaces {
+            n_phi: n_of(self.friction),
+            n_psi: n_of(self.dilation),
+            kc: self.ucs(),
+            st: self.tensile_effective(),
+            a1: k + 4.0 * g / 3.0,
+            a2: k - 2.0 * g / 3.0,
+        }
+    }
+}
+
+/// N = (1 + sin a)/(1 − sin a) of an angle in degrees (eq. 31).
+fn n_of(deg: f64) -> f64 {
+    let s = deg.to_radians().sin();
+    (1.0 + s) / (1.0 - s)
+}
+
+/// The yield planes of the ordered sector σ1 ≤ σ2 ≤ σ3 and the elastic constants of
+/// the return mapping (see the module documentation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surfaces {
+    /// N_φ (eq. 31).
+    pub n_phi: f64,
+    /// N_ψ.
+    pub n_psi: f64,
+    /// 2c √N_φ, the uniaxial compressive strength (Pa).
+    pub kc: f64,
+    /// Effective tensile strength σ_t (Pa).
+    pub st: f64,
+    /// α1 = K + 4G/3 (Pa, eq. 26).
+    pub a1: f64,
+    /// α2 = K − 2G/3 (Pa, eq. 27).
+    pub a2: f64,
+}
+
+/// Number of yield planes in the ordered sector.
+const PLANES: usize = 6;
+
+/// What a return did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Return {
+    /// Corrected principal stresses (Pa), on the trial's axes (not re-sorted).
+    pub stress: [f64; 3],
+    /// Plastic strain increment in principal axes, Σ λ_k ∇g_k (-).
+    pub plastic_strain: [f64; 3],
+    /// The shear planes' part of `plastic_strain` (-).
+    pub shear_strain: [f64; 3],
+    /// The multipliers of the shear planes summed (-).
+    pub shear: f64,
+    /// The multipliers of the tension planes summed (-).
+    pub tension: f64,
+}
+
+impl Surfaces {
+    /// Plane k at principal stresses s (ordered sector): 0 the shear plane of eq. 29, 1
+    /// and 2 the shear planes of the pyramid's edges (σ2 in place of σ3, of σ1), 3–5
+    /// σ3, σ2, σ1 against σ_t.
+    pub fn plane(&self, k: usize, s: &[f64; 3]) -> f64 {
+        match k {
+            0 => self.n_phi * s[2] - s[0] - self.kc,
+            1 => self.n_phi * s[1] - s[0] - self.kc,
+            2 => self.n_phi * s[2] - s[1] - self.kc,
+            3 => s[2] - self.st,
+            4 => s[1] - self.st,
+            _ => s[0] - self.st,
+        }
+    }
+
+    fn gradient(&self, k: usize, n: f64) -> [f64; 3] {
+        match k {
+            0 => [-1.0, 0.0, n],
+            1 => [-1.0, n, 0.0],
+            2 => [0.0, -1.0, n],
+            3 => [0.0, 0.0, 1.0],
+            4 => [0.0, 1.0, 0.0],
+            _ => [1.0, 0.0, 0.0],
+        }
+    }
+
+    /// ∇f_k (principal components).
+    pub fn yield_gradient(&self, k: usize) -> [f64; 3] {
+        self.gradient(k, self.n_phi)
+    }
+
+    /// ∇g_k, the flow direction (eq. 32–33).
+    pub fn potential_gradient(&self, k: usize) -> [f64; 3] {
+        self.gradient(k, self.n_psi)
+    }
+
+    /// D m: the isotropic elastic matrix in principal axes applied to m (eq. 25).
+    pub fn elastic(&self, m: &[f64; 3]) -> [f64; 3] {
+        let t = m[0] + m[1] + m[2];
+        [
+            self.a1 * m[0] + self.a2 * (t - m[0]),
+            self.a1 * m[1] + self.a2 * (t - m[1]),
+            self.a1 * m[2] + self.a2 * (t - m[2]),
+        ]
+    }
+
+    /// The composite yield function of any principal stresses, in any order:
+    /// max(N_φ σ_max − σ_min − 2c√N_φ, σ_max − σ_t) (Pa). Positive means outside.
+    pub fn composite(&self, s: &[f64; 3]) -> f64 {
+        let hi = s[0].max(s[1]).max(s[2]);
+        let lo = s[0].min(s[1]).min(s[2]);
+        (self.n_phi * hi - lo - self.kc).max(hi - self.st)
+    }
+
+    /// The digest's h-function (shear domain when ≤ 0).
+    pub fn h(&self, s: &[f64; 3]) -> f64 {
+        let ap = (1.0 + self.n_phi * self.n_phi).sqrt() + self.n_phi;
+        let sp = self.st * self.n_phi - self.kc;
+        s[2] - self.st + ap * (s[0] - sp)
+    }
+
+    /// Returns the ordered trial principal stresses `s` (σ1 ≤ σ2 ≤ σ3) to the yield
+    /// surface, or `None` when `s` is not outside it.
+    pub fn return_map(&self, s: &[f64; 3]) -> Option<Return> {
+        let scale = s[0].abs().max(s[2].abs()).max(self.kc).max(self.st);
+        if self.composite(s) <= 0.0 {
+            return None;
+        }
+        let tol = 1e-12 * scale.max(f64::MIN_POSITIVE);
+        // Singles (the h-function picks which of shear and tension comes first), then
+        // pairs, then triples; the first admissible set wins, else the least violating.
+        let singles = if self.h(s) <= 0.0 {
+            [0, 3, 1, 2, 4, 5]
+        } else {
+            [3, 0, 1, 2, 4, 5]
+        };
+        let mut best: Option<(f64, Return)> = None;
+        let mut admissible = |set: &[usize]| -> Option<Return> {
+            let r = self.solve(s, set)?;
+            let violation = self.composite(&r.stress);
+            if violation <= tol {
+                return Some(r);
+            }
+            if best.is_none_or(|(v, _)| violation < v) {
+                best = Some((violation, r));
+            }
+            None
+        };
+        for k in singles {
+            if let Some(r) = admissible(&[k]) {
+                return Some(r);
+            }
+        }
+        for i in 0..PLANES {
+            for j in i + 1..PLANES {
+                if let Some(r) = admissible(&[i, j]) {
+                    return Some(r);
+                }
+            }
+        }
+        for i in 0..PLANES {
+            for j in i + 1..PLANES {
+                for k in j + 1..PLANES {
+                    if let Some(r) = admissible(&[i, j, k]) {
+                        return Some(r);
+                    }
+                }
+            }
+        }
+        best.map(|(_, r)| r)
+    }
+
+    /// The return onto the planes `set` together: λ from f_k(σ* − Σ_j λ_j D∇g_j) = 0;
+    /// `None` when a multiplier is negative or the planes are dependent.
+    fn solve(&self, s: &[f64; 3], set: &[usize]) -> Option<Return> {
+        let n = set.len();
+        let mut dg = [[0.0; 3]; 3];
+        for (c, &j) in set.iter().enumerate() {
+            dg[c] = self.elastic(&self.potential_gradient(j));
+        }
+        let mut a = [[0.0; 3]; 3];
+        let mut b = [0.0; 3];
+        for (r, &k) in set.iter().enumerate() {
+            let df = self.yield_gradient(k);
+            for c in 0..n {
+                a[r][c] = dot(&df, &dg[c]);
+            }
+            b[r] = self.plane(k, s);
+        }
+        let lambda = solve_small(&a, &b, n)?;
+        if lambda[..n].iter().any(|&l| l < 0.0) {
+            return None;
+        }
+        let mut out = *s;
+        let (mut ep, mut eps) = ([0.0; 3], [0.0; 3]);
+        let (mut shear, mut tension) = (0.0, 0.0);
+        for (c, &j) in set.iter().enumerate() {
+            let g = self.potential_gradient(j);
+            for i in 0..3 {
+                out[i] -= lambda[c] * dg[c][i];
+                ep[i] += lambda[c] * g[i];
+                if j < 3 {
+                    eps[i] += lambda[c] * g[i];
+                }
+            }
+            if j < 3 {
+                shear += lambda[c];
+            } else {
+                tension += lambda[c];
+            }
+        }
+        Some(Return {
+            stress: out,
+            plastic_strain: ep,
+            shear_strain: eps,
+            shear,
+            tension,
+        })
+    }
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Solves the leading n×n block of a x = b (n ≤ 3) by Gaussian elimination with partial
+/// pivoting; `None` if singular.
+fn solve_small(a: &[[f64; 3]; 3], b: &[f64; 3], n: usize) -> Option<[f64; 3]> {
+    let (mut a, mut b) = (*a, *b);
+    let norm = a
+        .iter()
+        .take(n)
+        .flat_map(|r| r.iter().take(n))
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    for c in 0..n {
+        let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
+        if a[p][c].abs() <= 1e-12 * norm {
+            return None;
+        }
+        a.swap(c, p);
+        b.swap(c, p);
+        for r in c + 1..n {
+            let f = a[r][c] / a[c][c];
+            for k in c..n {
+                a[r][k] -= f * a[c][k];
+            }
+            b[r] -= f * b[c];
+        }
+    }
+    let mut x = [0.0; 3];
+    for c in (0..n).rev() {
+        let mut v = b[c];
+        for k in c + 1..n {
+            v -= a[c][k] * x[k];
+        }
+        x[c] = v / a[c][c];
+    }
+    Some(x)
+}
+
+impl ConstitutiveModel for MohrCoulomb {
+    fn name(&self) -> &str {
+        "mech-mohr-coulomb"
+    }
+    fn density(&self) -> f64 {
+        self.elastic.density()
+    }
+    fn young(&self) -> f64 {
+        self.elastic.young()
+    }
+    fn wave_modulus(&self) -> f64 {
+        self.elastic.lambda() + 2.0 * self.elastic.shear()
+    }
+    fn damp_factor(&self) -> f64 {
+        self.elastic.damp_factor()
+    }
+    fn contact_friction(&self) -> f64 {
+        self.elastic.friction()
+    }
+    fn contact_penalty(&self) -> f64 {
+        self.elastic.contact_penalty()
+    }
+    fn n_state(&self) -> usize {
+        MC_STATE
+    }
+    fn update(&self, _strain: &Sym6, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) {
+        let e = &self.elastic;
+        add_hooke(e.lambda(), 2.0 * e.shear(), de, stress);
+        st[state::SHEAR_NOW] = 0.0;
+        st[state::TENSION_NOW] = 0.0;
+        let surf = self.surfaces();
+        let p = principal(stress);
+        let Some(r) = surf.return_map(&p.values) else {
+            return;
+        };
+        *stress = compose(&r.stress, &p.axes);
+        if r.shear > 0.0 {
+            st[state::SHEAR_NOW] = 1.0;
+            st[state::SHEAR_PAST] = 1.0;
+            // FLAC's shear hardening parameter from the shear planes' plastic strain.
+            let ep = r.shear_strain;
+            let m = (ep[0] + ep[2]) / 3.0;
+            st[state::SHEAR_STRAIN] +=
+                (0.5 * ((ep[0] - m).powi(2) + m * m + (ep[2] - m).powi(2))).sqrt();
+        }
+        if r.tension > 0.0 {
+            st[state::TENSION_NOW] = 1.0;
+            st[state::TENSION_PAST] = 1.0;
+            st[state::TENSION_STRAIN] += r.tension;
+        }
+    }
+}

@@ -1,0 +1,150 @@
+//! Principal values and axes of a symmetric 3×3 tensor by cyclic Jacobi rotations.
+//!
+//! Hand-written rather than nalgebra's `SymmetricEigen` because the plastic models'
+//! WGSL bodies must repeat the same operations to match the CPU to rounding: Jacobi needs
+//! only + − × ÷ and `sqrt`, a fixed sweep order and a fixed stop, all of which WGSL has.
+//! In plane strain (xz = yz = 0) only the xy rotation is ever non-trivial, so σzz stays a
+//! principal value with axis z exactly.
+
+use crate::model::Sym6;
+
+/// Largest number of Jacobi sweeps; 3×3 tensors converge (off-diagonal below 1e-300 of
+/// the diagonal) in at most 5–6 sweeps in practice.
+const MAX_SWEEPS: usize = 12;
+
+/// Principal values `values[0] ≤ values[1] ≤ values[2]` (tension positive: `values[0]`
+/// is the most compressive) and unit axes `axes[i]` (a column each) of a symmetric
+/// tensor given as xx, yy, zz, xy, yz, xz.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Principal {
+    /// Principal values, ascending.
+    pub values: [f64; 3],
+    /// `axes[i]` is the unit axis of `values[i]` (x, y, z components).
+    pub axes: [[f64; 3]; 3],
+}
+
+/// Decomposes `t` (xx, yy, zz, xy, yz, xz) into principal values and axes.
+pub fn principal(t: &Sym6) -> Principal {
+    let mut a = [[t[0], t[3], t[5]], [t[3], t[1], t[4]], [t[5], t[4], t[2]]];
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _ in 0..MAX_SWEEPS {
+        let off = a[0][1] * a[0][1] + a[1][2] * a[1][2] + a[0][2] * a[0][2];
+        let diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+        if off <= 1e-300 * diag || off == 0.0 {
+            break;
+        }
+        for (p, q) in [(0, 1), (1, 2), (0, 2)] {
+            rotate(&mut a, &mut v, p, q);
+        }
+    }
+    // Sort ascending, carrying the axes (columns of v).
+    let mut idx = [0usize, 1, 2];
+    let d = [a[0][0], a[1][1], a[2][2]];
+    if d[idx[1]] < d[idx[0]] {
+        idx.swap(0, 1);
+    }
+    if d[idx[2]] < d[idx[1]] {
+        idx.swap(1, 2);
+    }
+    if d[idx[1]] < d[idx[0]] {
+        idx.swap(0, 1);
+    }
+    let axis = |k: usize| [v[0][k], v[1][k], v[2][k]];
+    Principal {
+        values: [d[idx[0]], d[idx[1]], d[idx[2]]],
+        axes: [axis(idx[0]), axis(idx[1]), axis(idx[2])],
+    }
+}
+
+/// One Jacobi rotation zeroing `a[p][q]` (Numerical Recipes' stable form).
+fn rotate(a: &mut [[f64; 3]; 3], v: &mut [[f64; 3]; 3], p: usize, q: usize) {
+    let apq = a[p][q];
+    if apq == 0.0 {
+        return;
+    }
+    let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
+    let t = if theta >= 0.0 {
+        1.0 / (theta + (theta * theta + 1.0).sqrt())
+    } else {
+        -1.0 / (-theta + (theta * theta + 1.0).sqrt())
+    };
+    let c = 1.0 / (t * t + 1.0).sqrt();
+    let s = t * c;
+    let r = 3 - p - q; // the third index
+    let (app, aqq, apr, aqr) = (a[p][p], a[q][q], a[p][r], a[q][r]);
+    a[p][p] = app - t * apq;
+    a[q][q] = aqq + t * apq;
+    a[p][q] = 0.0;
+    a[q][p] = 0.0;
+    a[p][r] = c * apr - s * aqr;
+    a[r][p] = a[p][r];
+    a[q][r] = s * apr + c * aqr;
+    a[r][q] = a[q][r];
+    for row in v.iter_mut() {
+        let (vp, vq) = (row[p], row[q]);
+        row[p] = c * vp - s * vq;
+        row[q] = s * vp + c * vq;
+    }
+}
+
+/// The tensor Σ_i `values[i]` axes_i ⊗ axes_i (xx, yy, zz, xy, yz, xz): the inverse of
+/// [`principal`] for new principal values on the same axes.
+pub fn compose(values: &[f64; 3], axes: &[[f64; 3]; 3]) -> Sym6 {
+    let mut t = [0.0; 6];
+    for (s, n) in values.iter().zip(axes) {
+        t[0] += s * n[0] * n[0];
+        t[1] += s * n[1] * n[1];
+        t[2] += s * n[2] * n[2];
+        t[3] += s * n[0] * n[1];
+        t[4] += s * n[1] * n[2];
+        t[5] += s * n[0] * n[2];
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64, scale: f64) -> bool {
+        (a - b).abs() <= 1e-13 * scale
+    }
+
+    #[test]
+    fn reproduces_the_tensor_and_orders_the_values() {
+        let t = [3.0, -2.0, 0.5, 1.25, -0.75, 2.0];
+        let p = principal(&t);
+        assert!(p.values[0] <= p.values[1] && p.values[1] <= p.values[2]);
+        let back = compose(&p.values, &p.axes);
+        for k in 0..6 {
+            assert!(close(back[k], t[k], 4.0), "{k}: {} vs {}", back[k], t[k]);
+        }
+        // Trace and orthonormal axes.
+        assert!(close(p.values.iter().sum::<f64>(), t[0] + t[1] + t[2], 4.0));
+        for i in 0..3 {
+            for j in 0..3 {
+                let d: f64 = (0..3).map(|k| p.axes[i][k] * p.axes[j][k]).sum();
+                assert!(close(d, if i == j { 1.0 } else { 0.0 }, 1.0));
+            }
+        }
+    }
+
+    #[test]
+    fn plane_strain_keeps_z_a_principal_axis_exactly() {
+        let t = [-5.0, 1.0, -2.0, 3.0, 0.0, 0.0];
+        let p = principal(&t);
+        let z = p.axes.iter().position(|a| a[2] != 0.0).unwrap();
+        assert_eq!(p.axes[z], [0.0, 0.0, 1.0]);
+        assert_eq!(p.values[z], -2.0);
+        let back = compose(&p.values, &p.axes);
+        assert_eq!((back[4], back[5]), (0.0, 0.0));
+    }
+
+    #[test]
+    fn diagonal_and_repeated_values() {
+        let p = principal(&[2.0, 2.0, 2.0, 0.0, 0.0, 0.0]);
+        assert_eq!(p.values, [2.0; 3]);
+        let p = principal(&[1.0, 1.0, 4.0, 0.0, 0.0, 0.0]);
+        assert_eq!(p.values, [1.0, 1.0, 4.0]);
+    }
+}

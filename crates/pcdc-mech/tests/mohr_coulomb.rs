@@ -1,0 +1,234 @@
+//! Mohr–Coulomb with tension cut-off: the return mapping's properties (manual 7.2.4).
+
+use pcdc_mech::mohr_coulomb::{state, Surfaces, MC_STATE};
+use pcdc_mech::principal::principal;
+use pcdc_mech::{ConstitutiveModel, LinearElastic, MohrCoulomb, Sym6};
+use proptest::prelude::*;
+
+fn model(c: f64, phi: f64, psi: f64, st: f64) -> MohrCoulomb {
+    let e = LinearElastic::new(10e9, 0.25, 2600.0).unwrap();
+    MohrCoulomb::new(e, c, phi, psi, st).unwrap()
+}
+
+fn add(a: &[f64; 3], b: &[f64; 3], f: f64) -> [f64; 3] {
+    [a[0] + f * b[0], a[1] + f * b[1], a[2] + f * b[2]]
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[test]
+fn uniaxial_compression_yields_at_two_c_root_n() {
+    let m = model(5e6, 30.0, 10.0, 2e6);
+    // N_φ = 3 at 30°: UCS = 2c√3.
+    assert!((m.ucs() - 2.0 * 5e6 * 3f64.sqrt()).abs() < 1e-6);
+    let s = m.surfaces();
+    let r = s.return_map(&[-2.0 * m.ucs(), 0.0, 0.0]).expect("plastic");
+    assert!(s.plane(0, &r.stress).abs() < 1e-6, "{:?}", r.stress);
+    assert!(r.shear > 0.0 && r.tension == 0.0);
+}
+
+#[test]
+fn triaxial_yield_follows_sigma3_n_phi_plus_ucs() {
+    // Yield at σ1 = σ3 N_φ + 2c√N_φ in compression magnitudes, for several confinements.
+    let m = model(2e6, 35.0, 0.0, 1e6);
+    let s = m.surfaces();
+    for conf in [0.0, 2e6, 5e6, 10e6] {
+        let yield_at = conf * s.n_phi + s.kc;
+        // Just inside and just outside along the axial stress.
+        let inside = [-(yield_at * (1.0 - 1e-9)), -conf, -conf];
+        assert!(s.return_map(&inside).is_none(), "confinement {conf}");
+        let outside = [-(yield_at * 1.01), -conf, -conf];
+        let r = s.return_map(&outside).expect("plastic");
+        assert!(s.composite(&r.stress).abs() <= 1e-6, "{:?}", r.stress);
+    }
+}
+
+#[test]
+fn tension_returns_sigma3_to_the_tensile_strength() {
+    let m = model(5e6, 30.0, 10.0, 1e6);
+    let s = m.surfaces();
+    let r = s.return_map(&[0.0, 0.0, 3e6]).expect("plastic");
+    assert!((r.stress[2] - 1e6).abs() < 1e-6, "{:?}", r.stress);
+    assert!(r.tension > 0.0 && r.shear == 0.0);
+    // The digest's tension correction: σ1, σ2 move by λ α2 with λ = (σ_t − σ3)/α1.
+    let l = (1e6 - 3e6) / s.a1;
+    assert!((r.stress[0] - l * s.a2).abs() < 1e-6);
+}
+
+#[test]
+fn tensile_strength_is_capped_at_c_cot_phi() {
+    let m = model(1e6, 45.0, 0.0, 5e6);
+    assert!((m.tensile_effective() - 1e6).abs() < 1e-6);
+    assert_eq!(model(1e6, 0.0, 0.0, 5e6).tensile_effective(), 5e6);
+}
+
+#[test]
+fn elastic_states_are_untouched_and_flags_follow_yield() {
+    let m = model(5e6, 30.0, 10.0, 1e6);
+    let e = m.elastic().clone();
+    let de: Sym6 = [1e-5, -2e-5, 0.0, 3e-6, 0.0, 0.0];
+    let mut a: Sym6 = [-1e6, -2e6, -1.5e6, 1e5, 0.0, 0.0];
+    let mut b = a;
+    let mut st = [0.0; MC_STATE];
+    m.update(&[0.0; 6], &de, &mut a, &mut st);
+    e.update(&[0.0; 6], &de, &mut b, &mut []);
+    assert_eq!(a, b);
+    assert_eq!(st, [0.0; MC_STATE]);
+    // A large shear strain yields; "now" clears on the next elastic step, "past" stays.
+    let big: Sym6 = [-5e-3, 5e-3, 0.0, 0.0, 0.0, 0.0];
+    m.update(&[0.0; 6], &big, &mut a, &mut st);
+    assert_eq!((st[state::SHEAR_NOW], st[state::SHEAR_PAST]), (1.0, 1.0));
+    assert!(st[state::SHEAR_STRAIN] > 0.0);
+    m.update(&[0.0; 6], &[0.0; 6], &mut a, &mut st);
+    assert_eq!((st[state::SHEAR_NOW], st[state::SHEAR_PAST]), (0.0, 1.0));
+}
+
+#[test]
+fn bad_parameters_are_refused_by_name() {
+    let e = LinearElastic::new(10e9, 0.25, 2600.0).unwrap();
+    let msg = |r: Result<MohrCoulomb, pcdc_mech::MechError>| r.unwrap_err().to_string();
+    assert!(msg(MohrCoulomb::new(e.clone(), -1.0, 30.0, 0.0, 0.0)).contains("cohesion"));
+    assert!(msg(MohrCoulomb::new(e.clone(), 1.0, 90.0, 0.0, 0.0)).contains("friction"));
+    assert!(msg(MohrCoulomb::new(e.clone(), 1.0, 30.0, 31.0, 0.0)).contains("dilation"));
+    assert!(msg(MohrCoulomb::new(e.clone(), 1.0, 30.0, 0.0, f64::NAN)).contains("tensile"));
+    assert!(msg(MohrCoulomb::new(e, 0.0, 0.0, 0.0, 0.0)).contains("cohesion"));
+    // The same check on deserialisation.
+    let json = r#"{"elastic":{"young":1e9,"poisson":0.2,"density":2000},
+                   "cohesion":1e6,"friction":20,"dilation":25,"tensile":0}"#;
+    let err = serde_json::from_str::<MohrCoulomb>(json)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("dilation"), "{err}");
+}
+
+fn params() -> impl Strategy<Value = MohrCoulomb> {
+    (
+        1e9..1e11f64,
+        -0.3..0.45f64,
+        0.0..1.0f64,
+        0.0..60.0f64,
+        0.0..1.0f64,
+        0.0..2.0f64,
+    )
+        .prop_map(|(young, nu, c, phi, psi_frac, st)| {
+            let e = LinearElastic::new(young, nu, 2500.0).unwrap();
+            // c from 0.1 to 10 MPa (nonzero: a strength scale for the tolerances).
+            let c = 1e5 * 100f64.powf(c);
+            MohrCoulomb::new(e, c, phi, psi_frac * phi, st * c).unwrap()
+        })
+}
+
+fn tensor(scale: f64) -> impl Strategy<Value = Sym6> {
+    prop::array::uniform6(-1.0..1.0f64).prop_map(move |t| t.map(|v| v * scale))
+}
+
+proptest! {
+    /// The corrected stress never lies outside the yield surface, and the plastic
+    /// dissipation σ:Δεᵖ is non-negative.
+    #[test]
+    fn returned_stress_is_admissible_and_dissipates(m in params(), t in tensor(1.0)) {
+        let s = m.surfaces();
+        let scale = 20.0 * s.kc;
+        let trial = principal(&t.map(|v| v * scale)).values;
+        if let Some(r) = s.return_map(&trial) {
+            prop_assert!(s.composite(&r.stress) <= 1e-9 * scale,
+                "{:?} -> {:?}: {}", trial, r.stress, s.composite(&r.stress));
+            prop_assert!(dot(&r.stress, &r.plastic_strain) >= -1e-12 * scale * r.plastic_strain.iter().map(|v| v.abs()).sum::<f64>());
+            prop_assert!(r.shear >= 0.0 && r.tension >= 0.0);
+            // The correction is the elastic image of the plastic strain.
+            let d = s.elastic(&r.plastic_strain);
+            for i in 0..3 {
+                prop_assert!((trial[i] - r.stress[i] - d[i]).abs() <= 1e-9 * scale);
+            }
+        } else {
+            prop_assert!(s.composite(&trial) <= 0.0);
+        }
+    }
+
+    /// A point inside the shear face or inside the tension face, pushed out by λ along
+    /// the elastic image of that plane's potential gradient, returns to itself with
+    /// plastic strain λ ∇g: the correction is along the potential's gradient.
+    #[test]
+    fn correction_is_along_the_potential_gradient(
+        m in params(), u in 0.05..0.95f64, w in 0.05..0.95f64, l in 1e-6..1e-2f64
+    ) {
+        let s = m.surfaces();
+        let lambda = l * s.kc / s.a1;
+        // Shear face: σ3 below σ_t, σ1 on the plane, σ2 strictly between.
+        let s3 = s.st - (0.2 + u) * s.kc;
+        let s1 = s.n_phi * s3 - s.kc;
+        let on = [s1, s1 + w * (s3 - s1), s3];
+        let g = s.potential_gradient(0);
+        let r = s.return_map(&add(&on, &s.elastic(&g), lambda)).expect("outside");
+        for i in 0..3 {
+            prop_assert!((r.stress[i] - on[i]).abs() <= 1e-9 * s.kc, "{:?} vs {:?}", r.stress, on);
+            prop_assert!((r.plastic_strain[i] - lambda * g[i]).abs() <= 1e-8 * lambda);
+        }
+        prop_assert_eq!(r.tension, 0.0);
+        // Tension face: σ3 = σ_t, σ1 above the shear–tension corner, σ2 between.
+        let corner = s.n_phi * s.st - s.kc;
+        prop_assume!(s.st - corner > 1e-6 * s.kc);
+        let s1 = corner + (0.1 + 0.8 * u) * (s.st - corner);
+        let on = [s1, s1 + 0.9 * w * (s.st - s1), s.st];
+        let g = s.potential_gradient(3);
+        let r = s.return_map(&add(&on, &s.elastic(&g), lambda)).expect("outside");
+        for i in 0..3 {
+            prop_assert!((r.stress[i] - on[i]).abs() <= 1e-9 * s.kc, "{:?} vs {:?}", r.stress, on);
+            prop_assert!((r.plastic_strain[i] - lambda * g[i]).abs() <= 1e-8 * lambda);
+        }
+        prop_assert_eq!(r.shear, 0.0);
+    }
+
+    /// With ψ = 0 the shear planes' plastic flow keeps the volume.
+    #[test]
+    fn zero_dilation_keeps_plastic_volume(m in params(), t in tensor(1.0)) {
+        let m = MohrCoulomb::new(m.elastic().clone(), m.cohesion(), m.friction(), 0.0, m.tensile()).unwrap();
+        let s = m.surfaces();
+        let trial = principal(&t.map(|v| v * 20.0 * s.kc)).values;
+        if let Some(r) = s.return_map(&trial) {
+            let vol: f64 = r.shear_strain.iter().sum();
+            let size: f64 = r.shear_strain.iter().map(|v| v.abs()).sum();
+            prop_assert!(vol.abs() <= 1e-12 * size.max(f64::MIN_POSITIVE));
+        }
+    }
+
+    /// Through the full tensor update: the result is admissible, keeps the trial's
+    /// principal axes, and in plane strain keeps yz = xz = 0.
+    #[test]
+    fn tensor_update_is_admissible_and_coaxial(m in params(), t in tensor(1.0), plane in any::<bool>()) {
+        let kc = m.surfaces().kc;
+        let e = m.elastic().clone();
+        let mut de: Sym6 = t.map(|v| v * 20.0 * kc / e.young());
+        if plane {
+            de[2] = 0.0;
+            de[4] = 0.0;
+            de[5] = 0.0;
+        }
+        let mut sig = [0.0; 6];
+        let mut trial = [0.0; 6];
+        e.update(&[0.0; 6], &de, &mut trial, &mut []);
+        let mut st = [0.0; MC_STATE];
+        m.update(&[0.0; 6], &de, &mut sig, &mut st);
+        let p = principal(&sig);
+        let s: Surfaces = m.surfaces();
+        let scale = 20.0 * kc + trial.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        prop_assert!(s.composite(&p.values) <= 1e-9 * scale);
+        // Coaxial: σ and the trial commute (σ T = T σ).
+        let mat = |v: &Sym6| [[v[0], v[3], v[5]], [v[3], v[1], v[4]], [v[5], v[4], v[2]]];
+        let (a, b) = (mat(&sig), mat(&trial));
+        for i in 0..3 {
+            for j in 0..3 {
+                let ab: f64 = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+                let ba: f64 = (0..3).map(|k| b[i][k] * a[k][j]).sum();
+                prop_assert!((ab - ba).abs() <= 1e-9 * scale * scale);
+            }
+        }
+        if plane {
+            prop_assert_eq!((sig[4], sig[5]), (0.0, 0.0));
+        }
+        let yielded = st[state::SHEAR_NOW] + st[state::TENSION_NOW] > 0.0;
+        prop_assert_eq!(yielded, s.composite(&principal(&trial).values) > 0.0);
+    }
+}
