@@ -79,6 +79,9 @@ pub struct MohrCoulomb {
     friction: f64,
     dilation: f64,
     tensile: f64,
+    /// Derived once from the parameters: `update` runs per element per step.
+    #[serde(skip_serializing)]
+    surfaces: Surfaces,
 }
 
 #[derive(Deserialize)]
@@ -145,13 +148,16 @@ impl MohrCoulomb {
                  strength",
             ));
         }
-        Ok(MohrCoulomb {
+        let mut m = MohrCoulomb {
             elastic,
             cohesion,
             friction: friction_deg,
             dilation: dilation_deg,
             tensile,
-        })
+            surfaces: Surfaces::default(),
+        };
+        m.surfaces = m.derive_surfaces();
+        Ok(m)
     }
 
     /// The elastic part.
@@ -190,6 +196,10 @@ impl MohrCoulomb {
 
     /// The surfaces for the return mapping.
     pub fn surfaces(&self) -> Surfaces {
+        self.surfaces
+    }
+
+    fn derive_surfaces(&self) -> Surfaces {
         let (g, k) = (self.elastic.shear(), self.elastic.bulk());
         Surfaces {
             n_phi: n_of(self.friction),
@@ -210,7 +220,7 @@ fn n_of(deg: f64) -> f64 {
 
 /// The yield planes of the ordered sector σ1 ≤ σ2 ≤ σ3 and the elastic constants of
 /// the return mapping (see the module documentation).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Surfaces {
     /// N_φ (eq. 31).
     pub n_phi: f64,
@@ -455,7 +465,7 @@ impl ConstitutiveModel for MohrCoulomb {
         self.elastic.young()
     }
     fn wave_modulus(&self) -> f64 {
-        self.elastic.lambda() + 2.0 * self.elastic.shear()
+        ConstitutiveModel::wave_modulus(&self.elastic)
     }
     fn damp_factor(&self) -> f64 {
         self.elastic.damp_factor()
@@ -474,9 +484,8 @@ impl ConstitutiveModel for MohrCoulomb {
         add_hooke(e.lambda(), 2.0 * e.shear(), de, stress);
         st[state::SHEAR_NOW] = 0.0;
         st[state::TENSION_NOW] = 0.0;
-        let surf = self.surfaces();
         let p = principal(stress);
-        let Some(r) = surf.return_map(&p.values) else {
+        let Some(r) = self.surfaces.return_map(&p.values) else {
             return;
         };
         *stress = compose(&r.stress, &p.axes);

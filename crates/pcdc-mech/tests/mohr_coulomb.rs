@@ -232,3 +232,12 @@ proptest! {
         prop_assert_eq!(yielded, s.composite(&principal(&trial).values) > 0.0);
     }
 }
+
+#[test]
+fn serde_round_trip_keeps_the_model() {
+    let m = model(3e6, 35.0, 5.0, 1e6);
+    let json = serde_json::to_string(&m).unwrap();
+    let back: MohrCoulomb = serde_json::from_str(&json).unwrap();
+    assert_eq!(back, m);
+    assert_eq!(back.surfaces(), m.surfaces());
+}
