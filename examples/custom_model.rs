@@ -142,6 +142,7 @@ impl ConstitutiveModel for DamageElastic {
             key: "example_damage_elastic".into(),
             body: DAMAGE_ELASTIC_WGSL.into(),
             params: vec![l, mu, self.kappa0, self.kappa_f],
+            ..Default::default()
         })
     }
 }

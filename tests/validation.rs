@@ -266,3 +266,40 @@ fn injection_fracture_grows_along_the_maximum_stress() {
     let last = t.len() - 1;
     assert!((v[last] - injection::RATE * t[last]).abs() <= 1e-9 * v[last]);
 }
+
+/// Triaxial compression at σ3 = 0, 2, 5, 10 MPa and direct tension of one Mohr–Coulomb
+/// block, plane strain and 3D: plateau stresses and the dilatancy ratio.
+#[test]
+fn triaxial_yield_and_dilatancy_follow_mohr_coulomb() {
+    use pcdc_validation::scenes::triaxial::{self, Dimension};
+    let cpu = cpu();
+    for dim in [Dimension::Two, Dimension::Three] {
+        let o = triaxial::run(&cpu, &triaxial::Params::reduced(dim)).unwrap();
+        for c in &o.curves {
+            eprintln!(
+                "triaxial {dim:?} σ3 {:?}: plateau {:.4} MPa vs {:.4} ({:.3e}), dilatancy {:.4} vs {:.4}, yielded {}/{}, {} steps",
+                c.confinement.map(|s| s * 1e-6),
+                c.plateau * 1e-6,
+                c.expected * 1e-6,
+                c.error(),
+                c.dilatancy,
+                c.dilatancy_expected,
+                c.yielded,
+                o.elements,
+                c.steps
+            );
+            // Every element yields: the block is homogeneous.
+            assert_eq!(c.yielded, o.elements);
+        }
+        assert!(
+            o.error <= triaxial::TOL,
+            "{dim:?}: plateau error {}",
+            o.error
+        );
+        assert!(
+            o.dilatancy_error <= triaxial::DILATANCY_TOL,
+            "{dim:?}: dilatancy error {}",
+            o.dilatancy_error
+        );
+    }
+}

@@ -134,4 +134,4 @@ pub use boundary::{Boundary, Components, Constraint, FaceStress, ACCEL_VELOCITY}
 pub use error::MechError;
 pub use mechanics::{Mechanics, SurfaceProperties};
 pub use model::{double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};
-pub use mohr_coulomb::MohrCoulomb;
+pub use mohr_coulomb::{MohrCoulomb, Softening};

@@ -938,8 +938,18 @@ impl<D: Dim> Physics<D> for Mechanics {
         } else {
             (String::new(), template.replace("/*coupling*/", ""))
         };
+        // Helper functions once per distinct model code.
+        let mut functions = String::new();
+        let mut seen: Vec<&str> = Vec::new();
+        for w in &bodies {
+            if !seen.contains(&w.key.as_str()) {
+                seen.push(&w.key);
+                functions.push_str(&w.functions);
+                functions.push('\n');
+            }
+        }
         let source = format!(
-            "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{coupling_src}{}{template}",
+            "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{coupling_src}{functions}{}{template}",
             splice.source
         );
         let polar_tol = match setup.precision() {
@@ -1163,6 +1173,55 @@ mod gpu_tests {
             // Two materials of one model share one WGSL function.
             let (_, src) = &s2[0];
             assert_eq!(src.matches("fn model_").count(), 1);
+        }
+    }
+
+    #[test]
+    fn mohr_coulomb_kernels_validate_with_naga() {
+        use crate::mohr_coulomb::{MohrCoulomb, Softening};
+        let e = LinearElastic::new(1e9, 0.25, 2500.0).unwrap();
+        let plain = MohrCoulomb::new(e.clone(), 1e6, 30.0, 5.0, 0.5e6).unwrap();
+        let t = |p: &[(f64, f64)]| Some(pcdc_compute::Table::new("t", p).unwrap());
+        let soft = plain
+            .clone()
+            .with_softening(Softening {
+                cohesion: t(&[(0.0, 1e6), (1e-3, 0.2e6)]),
+                tensile: t(&[(0.0, 0.5e6), (1e-4, 0.0)]),
+                ..Default::default()
+            })
+            .unwrap();
+        let mech = || {
+            Mechanics::new()
+                .material(Range::All, plain.clone())
+                .material(
+                    Range::Ball {
+                        center: [0.0; 3],
+                        radius: 0.6,
+                    },
+                    soft.clone(),
+                )
+                .material(
+                    Range::Ball {
+                        center: [1.0; 3],
+                        radius: 0.8,
+                    },
+                    LinearElastic::new(2e9, 0.2, 2600.0).unwrap(),
+                )
+        };
+        let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
+        let m3 = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
+        for p in [Precision::F64, Precision::F32] {
+            let s2 = offline_kernel_sources::<_>(&m2, vec![Box::new(mech())], p).unwrap();
+            let s3 = offline_kernel_sources::<_>(&m3, vec![Box::new(mech())], p).unwrap();
+            for (label, src) in s2.iter().chain(&s3) {
+                if let Err(e) = validate_wgsl(src) {
+                    panic!("{label} ({}) does not validate:\n{e}", p.name());
+                }
+            }
+            // Two Mohr–Coulomb materials share one function and one copy of its helpers.
+            let (_, src) = &s2[0];
+            assert_eq!(src.matches("fn model_").count(), 2);
+            assert_eq!(src.matches("fn mc_return").count(), 1);
         }
     }
 

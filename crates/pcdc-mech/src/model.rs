@@ -141,7 +141,12 @@ impl<'a> ModelInput<'a> {
 /// `0.5f`) and keep to + − × ÷, `sqrt`, `abs`, `min`, `max`, `select` (drivers may lack
 /// f64 `exp`/`pow`/`sin`). To match the CPU to rounding, repeat the CPU's operations in
 /// the same order.
-#[derive(Clone, Debug, PartialEq)]
+///
+/// A long model may put helper functions in `functions` (module scope, spliced once per
+/// key before the model functions; they may call `param` and use `Real` and `Sym`);
+/// prefix their names with the model's to keep clear of other models. Most models leave
+/// it empty: build with `..Default::default()`.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct WgslModel {
     /// Identifies the code: models with equal keys must have equal bodies (they share one
     /// WGSL function and differ only in parameters).
@@ -150,6 +155,8 @@ pub struct WgslModel {
     pub body: String,
     /// Parameters read with `param(p, k)`.
     pub params: Vec<f64>,
+    /// Module-scope WGSL functions the body calls (may be empty).
+    pub functions: String,
 }
 
 /// Isotropic linear elasticity (manual eq. 20-24), updated incrementally
@@ -397,6 +404,7 @@ impl ConstitutiveModel for LinearElastic {
             key: "linear_elastic".into(),
             body: include_str!("shaders/linear_elastic.wgsl").into(),
             params: vec![self.lambda(), self.shear()],
+            ..Default::default()
         })
     }
     fn linear_tangent(&self) -> Option<[[f64; 6]; 6]> {

@@ -31,6 +31,15 @@
 //! * **Tension cut-off cap** σ_t ≤ c / tan φ (digest 2.2): beyond it the cut-off would
 //!   not meet the shear pyramid, and with it the plastic dissipation σ:Δε^p ≥ 0.
 //!
+//! * **Softening** \[NOT IN MANUAL: table 2 has constant strengths\] optional
+//!   piecewise-linear tables of c, φ, ψ against κ_s and σ_t against κ_t ([`Softening`],
+//!   FLAC's strain-softening model), evaluated at the κ the step starts from.
+//! * **GPU**: the WGSL body (`shaders/mohr_coulomb.wgsl`, helpers in
+//!   `shaders/mohr_coulomb_lib.wgsl`) repeats these operations in the same order; f64
+//!   matches the CPU to rounding (`tests/gpu_parity_mohr_coulomb.rs`). Without softening
+//!   it needs no trigonometry (N_φ, N_ψ, 2c√N_φ are parameters); with softening it takes
+//!   sin from a Taylor series (error < 3e-16 on [0, π/2]), since drivers may lack f64 sin.
+//!
 //! History per element ([`MohrCoulomb::n_state`], shown in VTU through the
 //! `model_state` field): `[0]` shear now, `[1]` shear in the past, `[2]` tension now,
 //! `[3]` tension in the past (1 or 0; "now" is this step, "past" any step since the last
@@ -40,8 +49,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::model::{add_hooke, ConstitutiveModel, LinearElastic, Sym6};
-use crate::principal::{compose, principal};
+use pcdc_compute::Table;
+
+use crate::model::{add_hooke, ConstitutiveModel, LinearElastic, Sym6, WgslModel};
+use crate::principal::{compose, principal, JACOBI_STOP};
 use crate::MechError;
 
 /// Number of history variables of [`MohrCoulomb`].
@@ -79,6 +90,8 @@ pub struct MohrCoulomb {
     friction: f64,
     dilation: f64,
     tensile: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    softening: Option<Softening>,
     /// Derived once from the parameters: `update` runs per element per step.
     #[serde(skip_serializing)]
     surfaces: Surfaces,
@@ -93,12 +106,103 @@ struct RawMohrCoulomb {
     #[serde(default)]
     dilation: f64,
     tensile: f64,
+    #[serde(default)]
+    softening: Option<Softening>,
 }
 
 impl TryFrom<RawMohrCoulomb> for MohrCoulomb {
     type Error = MechError;
     fn try_from(r: RawMohrCoulomb) -> Result<Self, MechError> {
-        MohrCoulomb::new(r.elastic, r.cohesion, r.friction, r.dilation, r.tensile)
+        let m = MohrCoulomb::new(r.elastic, r.cohesion, r.friction, r.dilation, r.tensile)?;
+        match r.softening {
+            Some(soft) => m.with_softening(soft),
+            None => Ok(m),
+        }
+    }
+}
+
+/// Softening (or hardening) of the strength with plastic strain, FLAC's strain-softening
+/// Mohr–Coulomb: piecewise-linear tables of cohesion c (Pa), friction angle φ and
+/// dilation angle ψ (degrees) against the accumulated plastic shear strain κ_s, and of
+/// the tensile strength σ_t (Pa) against the accumulated plastic tensile strain κ_t
+/// (both dimensionless; see the module documentation for their increments). A table
+/// left `None` keeps the model's constant. Values are constant beyond a table's ends.
+///
+/// The strengths of a step are those at the element's κ at the start of the step
+/// (explicit, as FLAC). At any κ the dilation angle used is min(ψ(κ), φ(κ)) and the
+/// tensile strength min(σ_t(κ_t), c(κ_s) / tan φ(κ_s)), so a table may soften φ below ψ
+/// or c below the cut-off without leaving the model inconsistent. Checked when set
+/// ([`MohrCoulomb::with_softening`]): every c and σ_t point non-negative and finite,
+/// every φ and ψ point in [0, 90) degrees, and κ increasing strictly from κ ≥ 0.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Softening {
+    /// Cohesion c (Pa) against κ_s.
+    #[serde(default)]
+    pub cohesion: Option<Table>,
+    /// Friction angle φ (degrees) against κ_s.
+    #[serde(default)]
+    pub friction: Option<Table>,
+    /// Dilation angle ψ (degrees) against κ_s.
+    #[serde(default)]
+    pub dilation: Option<Table>,
+    /// Tensile strength σ_t (Pa) against κ_t.
+    #[serde(default)]
+    pub tensile: Option<Table>,
+}
+
+impl Softening {
+    fn check(&self) -> Result<(), MechError> {
+        let tables = [
+            ("cohesion c", &self.cohesion, 0.0, f64::INFINITY),
+            ("friction angle φ", &self.friction, 0.0, 90.0),
+            ("dilation angle ψ", &self.dilation, 0.0, 90.0),
+            ("tensile strength σ_t", &self.tensile, 0.0, f64::INFINITY),
+        ];
+        for (name, table, lo, hi) in tables {
+            let Some(t) = table else { continue };
+            for (i, (k, v)) in t.points().enumerate() {
+                if k < 0.0 {
+                    return Err(MechError::param(
+                        format!("softening table of the {name}, point {i}: plastic strain"),
+                        k,
+                        "must be non-negative",
+                    ));
+                }
+                if !(v >= lo && v < hi) {
+                    return Err(MechError::param(
+                        format!("softening table of the {name}, point {i}"),
+                        v,
+                        if hi.is_finite() {
+                            format!("must lie in [{lo}, {hi}) degrees")
+                        } else {
+                            "must be non-negative and finite (Pa)".to_string()
+                        },
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The tables in the GPU layout: per table its point count, abscissae, values.
+    fn wgsl_params(&self, out: &mut Vec<f64>) {
+        for t in [
+            &self.cohesion,
+            &self.friction,
+            &self.dilation,
+            &self.tensile,
+        ] {
+            match t {
+                Some(t) => {
+                    let pts: Vec<(f64, f64)> = t.points().collect();
+                    out.push(pts.len() as f64);
+                    out.extend(pts.iter().map(|p| p.0));
+                    out.extend(pts.iter().map(|p| p.1));
+                }
+                None => out.push(0.0),
+            }
+        }
     }
 }
 
@@ -154,10 +258,38 @@ impl MohrCoulomb {
             friction: friction_deg,
             dilation: dilation_deg,
             tensile,
+            softening: None,
             surfaces: Surfaces::default(),
         };
-        m.surfaces = m.derive_surfaces();
+        m.surfaces = surfaces_of(&m.elastic, cohesion, friction_deg, dilation_deg, tensile);
         Ok(m)
+    }
+
+    /// Adds strength softening (hardening) with plastic strain; errors name the table
+    /// and point ([`Softening`]).
+    pub fn with_softening(mut self, softening: Softening) -> Result<Self, MechError> {
+        softening.check()?;
+        self.softening = Some(softening);
+        Ok(self)
+    }
+
+    /// The softening tables, if any.
+    pub fn softening(&self) -> Option<&Softening> {
+        self.softening.as_ref()
+    }
+
+    /// The surfaces at plastic strains κ_s, κ_t: [`Self::surfaces`] without softening,
+    /// else those of the tables' strengths ([`Softening`]).
+    pub fn surfaces_at(&self, kappa_s: f64, kappa_t: f64) -> Surfaces {
+        let Some(soft) = &self.softening else {
+            return self.surfaces;
+        };
+        let at = |t: &Option<Table>, x: f64, c: f64| t.as_ref().map_or(c, |t| t.eval(x));
+        let c = at(&soft.cohesion, kappa_s, self.cohesion);
+        let phi = at(&soft.friction, kappa_s, self.friction);
+        let psi = at(&soft.dilation, kappa_s, self.dilation).min(phi);
+        let st = at(&soft.tensile, kappa_t, self.tensile);
+        surfaces_of(&self.elastic, c, phi, psi, st)
     }
 
     /// The elastic part.
@@ -180,14 +312,9 @@ impl MohrCoulomb {
     pub fn tensile(&self) -> f64 {
         self.tensile
     }
-    /// The tensile strength the model uses: min(σ_t, c / tan φ) (Pa).
+    /// The tensile strength the model uses (before softening): min(σ_t, c / tan φ) (Pa).
     pub fn tensile_effective(&self) -> f64 {
-        let phi = self.friction.to_radians();
-        if phi > 0.0 {
-            self.tensile.min(self.cohesion / phi.tan())
-        } else {
-            self.tensile
-        }
+        tensile_cap(self.cohesion, self.friction, self.tensile)
     }
     /// Uniaxial compressive strength 2c √N_φ (Pa).
     pub fn ucs(&self) -> f64 {
@@ -198,17 +325,29 @@ impl MohrCoulomb {
     pub fn surfaces(&self) -> Surfaces {
         self.surfaces
     }
+}
 
-    fn derive_surfaces(&self) -> Surfaces {
-        let (g, k) = (self.elastic.shear(), self.elastic.bulk());
-        Surfaces {
-            n_phi: n_of(self.friction),
-            n_psi: n_of(self.dilation),
-            kc: self.ucs(),
-            st: self.tensile_effective(),
-            a1: k + 4.0 * g / 3.0,
-            a2: k - 2.0 * g / 3.0,
-        }
+/// min(σ_t, c / tan φ) (Pa; φ in degrees).
+fn tensile_cap(c: f64, phi_deg: f64, st: f64) -> f64 {
+    let phi = phi_deg.to_radians();
+    if phi > 0.0 {
+        st.min(c / phi.tan())
+    } else {
+        st
+    }
+}
+
+/// The surfaces of strengths c (Pa), φ, ψ (degrees), σ_t (Pa) on an elastic part.
+fn surfaces_of(e: &LinearElastic, c: f64, phi: f64, psi: f64, st: f64) -> Surfaces {
+    let (g, k) = (e.shear(), e.bulk());
+    let n_phi = n_of(phi);
+    Surfaces {
+        n_phi,
+        n_psi: n_of(psi),
+        kc: 2.0 * c * n_phi.sqrt(),
+        st: tensile_cap(c, phi, st),
+        a1: k + 4.0 * g / 3.0,
+        a2: k - 2.0 * g / 3.0,
     }
 }
 
@@ -484,8 +623,9 @@ impl ConstitutiveModel for MohrCoulomb {
         add_hooke(e.lambda(), 2.0 * e.shear(), de, stress);
         st[state::SHEAR_NOW] = 0.0;
         st[state::TENSION_NOW] = 0.0;
+        let surfaces = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
         let p = principal(stress);
-        let Some(r) = self.surfaces.return_map(&p.values) else {
+        let Some(r) = surfaces.return_map(&p.values) else {
             return;
         };
         *stress = compose(&r.stress, &p.axes);
@@ -503,5 +643,35 @@ impl ConstitutiveModel for MohrCoulomb {
             st[state::TENSION_PAST] = 1.0;
             st[state::TENSION_STRAIN] += r.tension;
         }
+    }
+    fn wgsl(&self) -> Option<WgslModel> {
+        let (e, f) = (&self.elastic, &self.surfaces);
+        let mut params = vec![
+            e.lambda(),
+            e.shear(),
+            f.a1,
+            f.a2,
+            f.n_phi,
+            f.n_psi,
+            f.kc,
+            f.st,
+            JACOBI_STOP,
+            f64::MIN_POSITIVE,
+            f64::from(u8::from(self.softening.is_some())),
+            self.cohesion,
+            self.friction,
+            self.dilation,
+            self.tensile,
+        ];
+        match &self.softening {
+            Some(soft) => soft.wgsl_params(&mut params),
+            None => params.extend([0.0; 4]),
+        }
+        Some(WgslModel {
+            key: "mohr_coulomb".into(),
+            body: include_str!("shaders/mohr_coulomb.wgsl").into(),
+            params,
+            functions: include_str!("shaders/mohr_coulomb_lib.wgsl").into(),
+        })
     }
 }

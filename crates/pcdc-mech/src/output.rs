@@ -88,7 +88,10 @@ pub const STEP_CELL_ARRAYS: [&str; 4] = ["stress", "strain", "sigma_1", "sigma_m
 
 /// Writes one VTU step on the deformed configuration: per node the displacement since
 /// the last [`crate::reset_displacement`] (m) and the velocity (m/s); per element the
-/// global stress (Pa), the strain, σ1 and the smallest principal stress (Pa). Returns
+/// global stress (Pa), the strain, σ1 and the smallest principal stress (Pa), and, when
+/// a model has history, each history variable as `model_state_k` (for
+/// [`crate::MohrCoulomb`]: 0 shear now, 1 shear past, 2 tension now, 3 tension past, 4
+/// κ_s, 5 κ_t; see [`crate::mohr_coulomb::state`]). Returns
 /// the path of the `.vtu` file written. Use [`write_step_with`] to add arrays.
 pub fn write_step<D: Dim>(
     series: &mut PvdSeries,
@@ -150,6 +153,11 @@ pub fn write_step_with<D: Dim>(
             values: &pn,
         },
     ];
+    // The models' history, one scalar array per variable (`model_state_0`, ...).
+    let (history, names) = model_state_columns(sim, sim.mesh().n_elements());
+    for (name, values) in names.iter().zip(&history) {
+        cell_data.push(DataArray::Scalar { name, values });
+    }
     cell_data.extend_from_slice(cells);
     let [dn, vn] = STEP_POINT_ARRAYS;
     let mut point_data = vec![
@@ -171,6 +179,25 @@ pub fn write_step_with<D: Dim>(
         &cell_data,
     )?;
     Ok(path)
+}
+
+/// The `model_state` field (when a model has history) split into one column per
+/// variable, with the VTU names `model_state_k`. The mechanics keeps one column even
+/// without history; a single all-zero column is not written (so a model with exactly one
+/// history variable shows it once it is non-zero).
+fn model_state_columns<D: Dim>(sim: &Simulation<D>, ne: usize) -> (Vec<Vec<f64>>, Vec<String>) {
+    let Ok(state) = sim.field(names::MODEL_STATE) else {
+        return (Vec::new(), Vec::new());
+    };
+    let n = state.len().checked_div(ne).unwrap_or(0);
+    // Models without history still get one (zero) column: leave it out.
+    if n == 1 && state.iter().all(|&v| v == 0.0) {
+        return (Vec::new(), Vec::new());
+    }
+    let cols = (0..n)
+        .map(|k| state.iter().skip(k).step_by(n).copied().collect())
+        .collect();
+    (cols, (0..n).map(|k| format!("model_state_{k}")).collect())
 }
 
 /// Area/volume-weighted average of per-element values at the nodes (`ncomp` values per

@@ -12,6 +12,10 @@ use crate::model::Sym6;
 /// the diagonal) in at most 5–6 sweeps in practice.
 const MAX_SWEEPS: usize = 12;
 
+/// The sweeps stop when the squared off-diagonal falls to this fraction of the squared
+/// diagonal (or to zero).
+pub const JACOBI_STOP: f64 = 1e-300;
+
 /// Principal values `values[0] ≤ values[1] ≤ values[2]` (tension positive: `values[0]`
 /// is the most compressive) and unit axes `axes[i]` (a column each) of a symmetric
 /// tensor given as xx, yy, zz, xy, yz, xz.
@@ -30,7 +34,7 @@ pub fn principal(t: &Sym6) -> Principal {
     for _ in 0..MAX_SWEEPS {
         let off = a[0][1] * a[0][1] + a[1][2] * a[1][2] + a[0][2] * a[0][2];
         let diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
-        if off <= 1e-300 * diag || off == 0.0 {
+        if off <= JACOBI_STOP * diag || off == 0.0 {
             break;
         }
         for (p, q) in [(0, 1), (1, 2), (0, 2)] {

@@ -147,6 +147,7 @@ return s;"
             key: format!("test_coupled_{n}"),
             body,
             params,
+            ..Default::default()
         })
     }
 }

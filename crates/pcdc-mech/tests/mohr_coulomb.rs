@@ -2,7 +2,7 @@
 
 use pcdc_mech::mohr_coulomb::{state, Surfaces, MC_STATE};
 use pcdc_mech::principal::principal;
-use pcdc_mech::{ConstitutiveModel, LinearElastic, MohrCoulomb, Sym6};
+use pcdc_mech::{ConstitutiveModel, LinearElastic, MohrCoulomb, Softening, Sym6};
 use proptest::prelude::*;
 
 fn model(c: f64, phi: f64, psi: f64, st: f64) -> MohrCoulomb {
@@ -240,4 +240,169 @@ fn serde_round_trip_keeps_the_model() {
     let back: MohrCoulomb = serde_json::from_str(&json).unwrap();
     assert_eq!(back, m);
     assert_eq!(back.surfaces(), m.surfaces());
+}
+
+fn tab(points: &[(f64, f64)]) -> Option<pcdc_compute::Table> {
+    Some(pcdc_compute::Table::new("softening", points).unwrap())
+}
+
+fn softening_model() -> MohrCoulomb {
+    model(4e6, 35.0, 10.0, 2e6)
+        .with_softening(Softening {
+            cohesion: tab(&[(0.0, 4e6), (1e-3, 1e6)]),
+            friction: tab(&[(0.0, 35.0), (2e-3, 30.0)]),
+            dilation: tab(&[(0.0, 10.0), (1e-3, 0.0)]),
+            tensile: tab(&[(0.0, 2e6), (5e-4, 0.0)]),
+        })
+        .unwrap()
+}
+
+#[test]
+fn softening_interpolates_the_strengths() {
+    let m = softening_model();
+    // At κ = 0 the model's own strengths.
+    assert_eq!(m.surfaces_at(0.0, 0.0), m.surfaces());
+    // Half way along the cohesion table, a quarter along the friction table.
+    let s = m.surfaces_at(5e-4, 2.5e-4);
+    let n = |deg: f64| {
+        let s = deg.to_radians().sin();
+        (1.0 + s) / (1.0 - s)
+    };
+    let n_phi = n(33.75);
+    assert!((s.n_phi - n_phi).abs() < 1e-12 * n_phi);
+    assert!((s.n_psi - n(5.0)).abs() < 1e-12);
+    assert!((s.kc - 2.0 * 2.5e6 * n_phi.sqrt()).abs() < 1e-6);
+    assert!((s.st - 1e6).abs() < 1e-6);
+    // Beyond the ends, the last values; the residual cut-off is zero.
+    let r = m.surfaces_at(1.0, 1.0);
+    assert!((r.kc - 2.0 * 1e6 * n(30.0).sqrt()).abs() < 1e-6);
+    assert_eq!(r.st, 0.0);
+    assert!((r.n_psi - 1.0).abs() < 1e-15);
+}
+
+#[test]
+fn softening_lowers_the_strength_along_a_shear_path() {
+    // Simple shear in plane strain under confinement: the peak is reached once, then the
+    // stress falls with κ_s towards the residual strength, and every step's stress lies
+    // on the surface of the κ it started from.
+    let m = softening_model();
+    let mut sig: Sym6 = [-5e6, -5e6, -5e6, 0.0, 0.0, 0.0];
+    let mut st = [0.0; MC_STATE];
+    let de: Sym6 = [0.0, 0.0, 0.0, 2e-5, 0.0, 0.0];
+    let mut peak: f64 = 0.0;
+    let mut last = 0.0;
+    for _ in 0..400 {
+        let k0 = (st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
+        m.update(&[0.0; 6], &de, &mut sig, &mut st);
+        let s = m.surfaces_at(k0.0, k0.1);
+        let p = principal(&sig);
+        assert!(s.composite(&p.values) <= 1e-9 * 1e7, "{:?}", p.values);
+        peak = peak.max(sig[3]);
+        last = sig[3];
+    }
+    assert!(
+        st[state::SHEAR_STRAIN] > 2e-3,
+        "κ_s = {}",
+        st[state::SHEAR_STRAIN]
+    );
+    // Residual: c = 1 MPa, φ = 30°: on the shear plane at σ1, σ3 of the last state.
+    let res = m.surfaces_at(1.0, 1.0);
+    let p = principal(&sig).values;
+    assert!(res.plane(0, &p).abs() <= 1e-6 * res.kc, "{p:?}");
+    // The peak: pure shear at mean stress p = −5 MPa on the peak surface,
+    // τ = (2c√N_φ − p (N_φ − 1)) / (N_φ + 1) (dilation raises |p| slightly at the peak).
+    let s0 = m.surfaces();
+    let tau = (s0.kc + 5e6 * (s0.n_phi - 1.0)) / (s0.n_phi + 1.0);
+    assert!(
+        (peak - tau).abs() < 0.02 * tau,
+        "peak {peak}, closed form {tau}"
+    );
+    assert!(last < 0.7 * peak, "peak {peak}, last {last}");
+}
+
+#[test]
+fn bad_softening_tables_are_refused_by_name() {
+    let m = model(4e6, 35.0, 10.0, 2e6);
+    let err = |s: Softening| m.clone().with_softening(s).unwrap_err().to_string();
+    let e = err(Softening {
+        cohesion: tab(&[(0.0, 4e6), (1e-3, -1.0)]),
+        ..Default::default()
+    });
+    assert!(e.contains("cohesion") && e.contains("point 1"), "{e}");
+    let e = err(Softening {
+        friction: tab(&[(0.0, 35.0), (1e-3, 90.0)]),
+        ..Default::default()
+    });
+    assert!(e.contains("friction") && e.contains("degrees"), "{e}");
+    let e = err(Softening {
+        tensile: tab(&[(-1e-3, 1e6), (1e-3, 0.0)]),
+        ..Default::default()
+    });
+    assert!(e.contains("tensile") && e.contains("plastic strain"), "{e}");
+    // And on deserialisation.
+    let json = r#"{"elastic":{"young":1e9,"poisson":0.2,"density":2000},
+                   "cohesion":1e6,"friction":20,"tensile":0,
+                   "softening":{"dilation":{"t":[0,1e-3],"v":[5,-1]}}}"#;
+    let e = serde_json::from_str::<MohrCoulomb>(json)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("dilation"), "{e}");
+}
+
+#[test]
+fn serde_round_trip_keeps_the_softening() {
+    let m = softening_model();
+    let json = serde_json::to_string(&m).unwrap();
+    let back: MohrCoulomb = serde_json::from_str(&json).unwrap();
+    assert_eq!(back, m);
+    assert_eq!(back.surfaces_at(3e-4, 1e-4), m.surfaces_at(3e-4, 1e-4));
+}
+
+/// The plastic history reaches ParaView: `output::write_step` writes one cell array per
+/// history variable, with the values of the `model_state` field.
+#[test]
+fn vtu_step_shows_the_plastic_state() {
+    use pcdc_compute::{Backend, Simulation};
+    use pcdc_mech::{output, Mechanics};
+    use pcdc_mesh::vtu::{PvdSeries, VtuEncoding};
+    use pcdc_mesh::{builders, Range};
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
+    // An initial deviatoric stress far beyond the strength of the upper half.
+    let upper = Range::HalfSpace {
+        point: [0.0, 0.5, 0.0],
+        normal: [0.0, 1.0, 0.0],
+    };
+    let mut sim = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+        .physics(
+            Mechanics::new()
+                .material(Range::All, model(5e6, 30.0, 0.0, 1e6))
+                .initial_stress(upper, [-60e6, 0.0, -20e6, 0.0, 0.0, 0.0]),
+        )
+        .build()
+        .unwrap();
+    sim.run(1).unwrap();
+    let dir = std::env::temp_dir().join(format!("pcdc-mc-vtu-{}", std::process::id()));
+    let mut series = PvdSeries::new(&dir, "mc")
+        .unwrap()
+        .with_encoding(VtuEncoding::Ascii);
+    let path = output::write_step(&mut series, &sim).unwrap();
+    let xml = std::fs::read_to_string(&path).unwrap();
+    let history = sim.field("model_state").unwrap().to_vec();
+    let ne = sim.mesh().n_elements();
+    let values = |name: &str| -> Vec<f64> {
+        let at = xml.find(&format!("Name=\"{name}\"")).expect(name);
+        let body = &xml[at..];
+        let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
+        body.split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect()
+    };
+    for k in 0..MC_STATE {
+        let want: Vec<f64> = (0..ne).map(|e| history[e * MC_STATE + k]).collect();
+        assert_eq!(values(&format!("model_state_{k}")), want, "variable {k}");
+    }
+    let shear_past = values("model_state_1");
+    let yielded = shear_past.iter().filter(|&&v| v == 1.0).count();
+    assert!(yielded > 0 && yielded < ne, "{yielded} of {ne} yielded");
+    std::fs::remove_dir_all(&dir).ok();
 }

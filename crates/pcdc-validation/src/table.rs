@@ -16,8 +16,8 @@ use pcdc_compute::{Backend, BackendKind, Precision};
 use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
-    block_sliding, brazilian, direct_tension, fracture_flow, injection, kirsch, radial_flow, ucs,
-    unconfined_flow, vibration_energy, wave_speed,
+    block_sliding, brazilian, direct_tension, fracture_flow, injection, kirsch, radial_flow,
+    triaxial, ucs, unconfined_flow, vibration_energy, wave_speed,
 };
 
 /// One measured row of the report.
@@ -125,6 +125,7 @@ pub const CASES: &[&str] = &[
     "fracture_flow",
     "unconfined_flow",
     "injection",
+    "triaxial",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -229,6 +230,15 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
         "injection" => {
             for size in [0.04, 0.03, injection::Params::full().size] {
                 out.push(j("injection", "mass balance", size));
+            }
+        }
+        // A homogeneous block: the mesh changes the cost, not the closed form.
+        "triaxial" => {
+            for size in [0.0125, 0.0075, 0.005] {
+                out.push(j("triaxial", "2d", size));
+            }
+            for size in [0.05, 0.025, 0.0125] {
+                out.push(j("triaxial", "3d", size));
             }
         }
         _ => {}
@@ -349,6 +359,31 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
                 vibration_energy::run_3d(backend, &p)?
             };
             within(o.elements, o.drift, vibration_energy::TOL, o.steps)
+        }
+        "triaxial" => {
+            let dim = if job.variant == "2d" {
+                triaxial::Dimension::Two
+            } else {
+                triaxial::Dimension::Three
+            };
+            let p = triaxial::Params {
+                size: job.size,
+                dim,
+                vtu_dir: None,
+            };
+            let o = triaxial::run(backend, &p)?;
+            row(
+                o.elements,
+                o.error,
+                format!(
+                    "{} % (σ1 = σ3 N_φ + 2c√N_φ; σ_t); dilatancy {} % (measured {:.2} %)",
+                    triaxial::TOL * 100.0,
+                    triaxial::DILATANCY_TOL * 100.0,
+                    o.dilatancy_error * 100.0
+                ),
+                o.error <= triaxial::TOL && o.dilatancy_error <= triaxial::DILATANCY_TOL,
+                o.steps,
+            )
         }
         "block_sliding" => {
             let o = block_sliding::run_sized(backend, 1.0, job.size)?;

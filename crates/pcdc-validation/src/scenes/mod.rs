@@ -21,6 +21,7 @@ pub mod kirsch;
 pub mod limits;
 pub mod platen_test;
 pub mod radial_flow;
+pub mod triaxial;
 pub mod ucs;
 pub mod unconfined_flow;
 pub mod vibration_energy;

@@ -1,0 +1,34 @@
+// Mohr–Coulomb with tension cut-off (manual 7.2.4; MohrCoulomb::update): elastic trial
+// (eq. 25-28), principal decomposition, active-set return (eq. 29 corrected, 30-33),
+// history: 0 shear now, 1 shear past, 2 tension now, 3 tension past, 4 κ_s, 5 κ_t.
+let l = param(p, 0u);
+let mu = param(p, 1u);
+let two_mu = 2.0 * mu;
+let tr = dstrain[0] + dstrain[1] + dstrain[2];
+var s = stress;
+s[0] = s[0] + (l * tr + two_mu * dstrain[0]);
+s[1] = s[1] + (l * tr + two_mu * dstrain[1]);
+s[2] = s[2] + (l * tr + two_mu * dstrain[2]);
+s[3] = s[3] + two_mu * dstrain[3];
+s[4] = s[4] + two_mu * dstrain[4];
+s[5] = s[5] + two_mu * dstrain[5];
+(*state)[0] = 0.0;
+(*state)[2] = 0.0;
+let f = mc_surfaces(p, (*state)[4], (*state)[5]);
+let pr = mc_principal(s, param(p, 8u));
+let r = mc_return(f, pr.values, param(p, 9u));
+if !r.ok {
+    return s;
+}
+if r.shear > 0.0 {
+    (*state)[0] = 1.0;
+    (*state)[1] = 1.0;
+    let m = (r.eps[0] + r.eps[2]) / 3.0;
+    (*state)[4] = (*state)[4] + sqrt(0.5 * ((r.eps[0] - m) * (r.eps[0] - m) + m * m + (r.eps[2] - m) * (r.eps[2] - m)));
+}
+if r.tension > 0.0 {
+    (*state)[2] = 1.0;
+    (*state)[3] = 1.0;
+    (*state)[5] = (*state)[5] + r.tension;
+}
+return mc_compose(r.s, pr.axes);

@@ -1,0 +1,382 @@
+// Mohr–Coulomb with tension cut-off (manual 7.2.4): the helpers of the model body, the
+// operations of mohr_coulomb.rs and principal.rs in the same order, so that f64 matches
+// the CPU to rounding. Parameters (param(p, k)): 0 λ, 1 μ (Pa), 2 α1, 3 α2 (Pa), 4 N_φ,
+// 5 N_ψ, 6 2c√N_φ (Pa), 7 σ_t (Pa), 8 the Jacobi stop (1e-300), 9 f64::MIN_POSITIVE,
+// 10 softening (0/1), 11 c (Pa), 12 φ, 13 ψ (degrees), 14 σ_t as given (Pa), then four
+// tables (c, φ, ψ against κ_s; σ_t against κ_t), each its point count n, n abscissae and
+// n values (n = 0: the constant).
+alias McV3 = array<Real, 3>;
+
+struct McSurf {
+    n_phi: Real,
+    n_psi: Real,
+    kc: Real,
+    st: Real,
+    a1: Real,
+    a2: Real,
+}
+
+struct McRet {
+    ok: bool,
+    s: McV3,
+    ep: McV3,
+    eps: McV3,
+    shear: Real,
+    tension: Real,
+}
+
+struct McPrin {
+    values: McV3,
+    axes: array<McV3, 3>,
+}
+
+// Plane k at principal stresses s: 0 shear (eq. 29 corrected), 1-2 the pyramid's edges,
+// 3-5 σ3, σ2, σ1 against σ_t.
+fn mc_plane(f: McSurf, k: u32, s: McV3) -> Real {
+    var r = s[0] - f.st;
+    switch k {
+        case 0u: { r = f.n_phi * s[2] - s[0] - f.kc; }
+        case 1u: { r = f.n_phi * s[1] - s[0] - f.kc; }
+        case 2u: { r = f.n_phi * s[2] - s[1] - f.kc; }
+        case 3u: { r = s[2] - f.st; }
+        case 4u: { r = s[1] - f.st; }
+        default: {}
+    }
+    return r;
+}
+
+fn mc_grad(k: u32, n: Real) -> McV3 {
+    var g = McV3(1.0, 0.0, 0.0);
+    switch k {
+        case 0u: { g = McV3(-1.0, 0.0, n); }
+        case 1u: { g = McV3(-1.0, n, 0.0); }
+        case 2u: { g = McV3(0.0, -1.0, n); }
+        case 3u: { g = McV3(0.0, 0.0, 1.0); }
+        case 4u: { g = McV3(0.0, 1.0, 0.0); }
+        default: {}
+    }
+    return g;
+}
+
+fn mc_elastic(f: McSurf, m: McV3) -> McV3 {
+    let t = m[0] + m[1] + m[2];
+    return McV3(f.a1 * m[0] + f.a2 * (t - m[0]), f.a1 * m[1] + f.a2 * (t - m[1]), f.a1 * m[2] + f.a2 * (t - m[2]));
+}
+
+fn mc_dot(a: McV3, b: McV3) -> Real {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+fn mc_composite(f: McSurf, s: McV3) -> Real {
+    let hi = max(max(s[0], s[1]), s[2]);
+    let lo = min(min(s[0], s[1]), s[2]);
+    return max(f.n_phi * hi - lo - f.kc, hi - f.st);
+}
+
+fn mc_h(f: McSurf, s: McV3) -> Real {
+    let ap = sqrt(1.0 + f.n_phi * f.n_phi) + f.n_phi;
+    let sp = f.st * f.n_phi - f.kc;
+    return s[2] - f.st + ap * (s[0] - sp);
+}
+
+// The return onto planes[0..n] together (Surfaces::solve).
+fn mc_solve(f: McSurf, s: McV3, planes: array<u32, 3>, n: u32) -> McRet {
+    var out: McRet;
+    out.ok = false;
+    var dg: array<McV3, 3>;
+    for (var c = 0u; c < n; c = c + 1u) {
+        dg[c] = mc_elastic(f, mc_grad(planes[c], f.n_psi));
+    }
+    var a: array<McV3, 3>;
+    var b = McV3(0.0, 0.0, 0.0);
+    for (var r = 0u; r < n; r = r + 1u) {
+        let df = mc_grad(planes[r], f.n_phi);
+        for (var c = 0u; c < n; c = c + 1u) {
+            a[r][c] = mc_dot(df, dg[c]);
+        }
+        b[r] = mc_plane(f, planes[r], s);
+    }
+    // Gaussian elimination with partial pivoting (solve_small: the last largest pivot).
+    var norm = Real(0.0);
+    for (var r = 0u; r < n; r = r + 1u) {
+        for (var c = 0u; c < n; c = c + 1u) {
+            norm = max(norm, abs(a[r][c]));
+        }
+    }
+    for (var c = 0u; c < n; c = c + 1u) {
+        var pv = c;
+        for (var i = c + 1u; i < n; i = i + 1u) {
+            if abs(a[i][c]) >= abs(a[pv][c]) {
+                pv = i;
+            }
+        }
+        if abs(a[pv][c]) <= 1e-12 * norm {
+            return out;
+        }
+        let ra = a[c];
+        a[c] = a[pv];
+        a[pv] = ra;
+        let rb = b[c];
+        b[c] = b[pv];
+        b[pv] = rb;
+        for (var r = c + 1u; r < n; r = r + 1u) {
+            let fr = a[r][c] / a[c][c];
+            for (var k = c; k < n; k = k + 1u) {
+                a[r][k] = a[r][k] - fr * a[c][k];
+            }
+            b[r] = b[r] - fr * b[c];
+        }
+    }
+    var x = McV3(0.0, 0.0, 0.0);
+    for (var cc = n; cc > 0u; cc = cc - 1u) {
+        let c = cc - 1u;
+        var v = b[c];
+        for (var k = c + 1u; k < n; k = k + 1u) {
+            v = v - a[c][k] * x[k];
+        }
+        x[c] = v / a[c][c];
+    }
+    for (var c = 0u; c < n; c = c + 1u) {
+        if x[c] < 0.0 {
+            return out;
+        }
+    }
+    out.s = s;
+    out.ep = McV3(0.0, 0.0, 0.0);
+    out.eps = McV3(0.0, 0.0, 0.0);
+    out.shear = 0.0;
+    out.tension = 0.0;
+    for (var c = 0u; c < n; c = c + 1u) {
+        let j = planes[c];
+        let g = mc_grad(j, f.n_psi);
+        for (var i = 0u; i < 3u; i = i + 1u) {
+            out.s[i] = out.s[i] - x[c] * dg[c][i];
+            out.ep[i] = out.ep[i] + x[c] * g[i];
+            if j < 3u {
+                out.eps[i] = out.eps[i] + x[c] * g[i];
+            }
+        }
+        if j < 3u {
+            out.shear = out.shear + x[c];
+        } else {
+            out.tension = out.tension + x[c];
+        }
+    }
+    out.ok = true;
+    return out;
+}
+
+// One candidate planes: true when admissible (then *found is it), else it may become the
+// least violating (*best, *best_v).
+fn mc_try(f: McSurf, s: McV3, planes: array<u32, 3>, n: u32, tol: Real, found: ptr<function, McRet>, best: ptr<function, McRet>, best_v: ptr<function, Real>) -> bool {
+    let r = mc_solve(f, s, planes, n);
+    if !r.ok {
+        return false;
+    }
+    let v = mc_composite(f, r.s);
+    if v <= tol {
+        *found = r;
+        return true;
+    }
+    if !(*best).ok || v < *best_v {
+        *best = r;
+        *best_v = v;
+    }
+    return false;
+}
+
+// Surfaces::return_map: ok = false when s is not outside the surface.
+fn mc_return(f: McSurf, s: McV3, min_pos: Real) -> McRet {
+    var found: McRet;
+    found.ok = false;
+    let scale = max(max(max(abs(s[0]), abs(s[2])), f.kc), f.st);
+    if mc_composite(f, s) <= 0.0 {
+        return found;
+    }
+    let tol = 1e-12 * max(scale, min_pos);
+    var singles = array<u32, 6>(0u, 3u, 1u, 2u, 4u, 5u);
+    if mc_h(f, s) > 0.0 {
+        singles = array<u32, 6>(3u, 0u, 1u, 2u, 4u, 5u);
+    }
+    var best: McRet;
+    best.ok = false;
+    var best_v = Real(0.0);
+    for (var i = 0u; i < 6u; i = i + 1u) {
+        if mc_try(f, s, array<u32, 3>(singles[i], 0u, 0u), 1u, tol, &found, &best, &best_v) {
+            return found;
+        }
+    }
+    for (var i = 0u; i < 6u; i = i + 1u) {
+        for (var j = i + 1u; j < 6u; j = j + 1u) {
+            if mc_try(f, s, array<u32, 3>(i, j, 0u), 2u, tol, &found, &best, &best_v) {
+                return found;
+            }
+        }
+    }
+    for (var i = 0u; i < 6u; i = i + 1u) {
+        for (var j = i + 1u; j < 6u; j = j + 1u) {
+            for (var k = j + 1u; k < 6u; k = k + 1u) {
+                if mc_try(f, s, array<u32, 3>(i, j, k), 3u, tol, &found, &best, &best_v) {
+                    return found;
+                }
+            }
+        }
+    }
+    return best;
+}
+
+// One Jacobi rotation zeroing a[p][q] (principal.rs: rotate).
+fn mc_rotate(a: ptr<function, array<McV3, 3>>, v: ptr<function, array<McV3, 3>>, p: u32, q: u32) {
+    let apq = (*a)[p][q];
+    if apq == 0.0 {
+        return;
+    }
+    let theta = ((*a)[q][q] - (*a)[p][p]) / (2.0 * apq);
+    var t = Real(0.0);
+    if theta >= 0.0 {
+        t = 1.0 / (theta + sqrt(theta * theta + 1.0));
+    } else {
+        t = -1.0 / (-theta + sqrt(theta * theta + 1.0));
+    }
+    let c = 1.0 / sqrt(t * t + 1.0);
+    let s = t * c;
+    let r = 3u - p - q;
+    let app = (*a)[p][p];
+    let aqq = (*a)[q][q];
+    let apr = (*a)[p][r];
+    let aqr = (*a)[q][r];
+    (*a)[p][p] = app - t * apq;
+    (*a)[q][q] = aqq + t * apq;
+    (*a)[p][q] = 0.0;
+    (*a)[q][p] = 0.0;
+    (*a)[p][r] = c * apr - s * aqr;
+    (*a)[r][p] = (*a)[p][r];
+    (*a)[q][r] = s * apr + c * aqr;
+    (*a)[r][q] = (*a)[q][r];
+    for (var i = 0u; i < 3u; i = i + 1u) {
+        let vp = (*v)[i][p];
+        let vq = (*v)[i][q];
+        (*v)[i][p] = c * vp - s * vq;
+        (*v)[i][q] = s * vp + c * vq;
+    }
+}
+
+// principal.rs: principal (cyclic Jacobi, values ascending, axes carried).
+fn mc_principal(t: Sym, jtol: Real) -> McPrin {
+    var a = array<McV3, 3>(McV3(t[0], t[3], t[5]), McV3(t[3], t[1], t[4]), McV3(t[5], t[4], t[2]));
+    var v = array<McV3, 3>(McV3(1.0, 0.0, 0.0), McV3(0.0, 1.0, 0.0), McV3(0.0, 0.0, 1.0));
+    for (var sweep = 0u; sweep < 12u; sweep = sweep + 1u) {
+        let off = a[0][1] * a[0][1] + a[1][2] * a[1][2] + a[0][2] * a[0][2];
+        let diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+        if off <= jtol * diag || off == 0.0 {
+            break;
+        }
+        mc_rotate(&a, &v, 0u, 1u);
+        mc_rotate(&a, &v, 1u, 2u);
+        mc_rotate(&a, &v, 0u, 2u);
+    }
+    var idx = array<u32, 3>(0u, 1u, 2u);
+    let d = McV3(a[0][0], a[1][1], a[2][2]);
+    if d[idx[1]] < d[idx[0]] {
+        idx = array<u32, 3>(idx[1], idx[0], idx[2]);
+    }
+    if d[idx[2]] < d[idx[1]] {
+        idx = array<u32, 3>(idx[0], idx[2], idx[1]);
+    }
+    if d[idx[1]] < d[idx[0]] {
+        idx = array<u32, 3>(idx[1], idx[0], idx[2]);
+    }
+    var out: McPrin;
+    for (var i = 0u; i < 3u; i = i + 1u) {
+        let k = idx[i];
+        out.values[i] = d[k];
+        out.axes[i] = McV3(v[0][k], v[1][k], v[2][k]);
+    }
+    return out;
+}
+
+// principal.rs: compose.
+fn mc_compose(values: McV3, axes: array<McV3, 3>) -> Sym {
+    var t = Sym(0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for (var i = 0u; i < 3u; i = i + 1u) {
+        let s = values[i];
+        let n = axes[i];
+        t[0] = t[0] + s * n[0] * n[0];
+        t[1] = t[1] + s * n[1] * n[1];
+        t[2] = t[2] + s * n[2] * n[2];
+        t[3] = t[3] + s * n[0] * n[1];
+        t[4] = t[4] + s * n[1] * n[2];
+        t[5] = t[5] + s * n[0] * n[2];
+    }
+    return t;
+}
+
+// sin x for x in [0, π/2] by its Taylor series to x^21 (error below 3e-16): drivers may
+// lack f64 sin. Only the softening tables need it.
+fn mc_sin(x: Real) -> Real {
+    let x2 = x * x;
+    var r = Real(1.9572941063391263e-20); // 1/21!
+    r = r * x2 - 8.220635246624331e-18; // 1/19!
+    r = r * x2 + 2.8114572543455206e-15;
+    r = r * x2 - 7.647163731819816e-13;
+    r = r * x2 + 1.6059043836821613e-10;
+    r = r * x2 - 2.505210838544172e-8;
+    r = r * x2 + 2.7557319223985893e-6;
+    r = r * x2 - 1.984126984126984e-4;
+    r = r * x2 + 8.333333333333333e-3;
+    r = r * x2 - 1.6666666666666666e-1;
+    r = r * x2 + 1.0;
+    return r * x;
+}
+
+// Table k (0 c, 1 φ, 2 ψ, 3 σ_t) at x, or `fallback` without points: linear between
+// points, constant beyond (pcdc_compute::Table::eval).
+fn mc_table(p: u32, k: u32, x: Real, fallback: Real) -> Real {
+    var at = 15u;
+    for (var j = 0u; j < k; j = j + 1u) {
+        at = at + 1u + 2u * u32(param(p, at));
+    }
+    let n = u32(param(p, at));
+    if n == 0u {
+        return fallback;
+    }
+    let t0 = at + 1u;
+    let v0 = at + 1u + n;
+    if x <= param(p, t0) {
+        return param(p, v0);
+    }
+    if x >= param(p, t0 + n - 1u) {
+        return param(p, v0 + n - 1u);
+    }
+    var i = 1u;
+    while param(p, t0 + i) <= x {
+        i = i + 1u;
+    }
+    let ta = param(p, t0 + i - 1u);
+    let tb = param(p, t0 + i);
+    let va = param(p, v0 + i - 1u);
+    let vb = param(p, v0 + i);
+    return va + (vb - va) * (x - ta) / (tb - ta);
+}
+
+// The surfaces at the element's plastic strains (MohrCoulomb::surfaces_at).
+fn mc_surfaces(p: u32, ks: Real, kt: Real) -> McSurf {
+    var f = McSurf(param(p, 4u), param(p, 5u), param(p, 6u), param(p, 7u), param(p, 2u), param(p, 3u));
+    if param(p, 10u) == 0.0 {
+        return f;
+    }
+    let c = mc_table(p, 0u, ks, param(p, 11u));
+    let phi = mc_table(p, 1u, ks, param(p, 12u));
+    let psi = min(mc_table(p, 2u, ks, param(p, 13u)), phi);
+    let st = mc_table(p, 3u, kt, param(p, 14u));
+    let sphi = mc_sin(phi * 0.017453292519943295);
+    let spsi = mc_sin(psi * 0.017453292519943295);
+    f.n_phi = (1.0 + sphi) / (1.0 - sphi);
+    f.n_psi = (1.0 + spsi) / (1.0 - spsi);
+    f.kc = 2.0 * c * sqrt(f.n_phi);
+    f.st = st;
+    if phi > 0.0 {
+        f.st = min(st, c * sqrt(1.0 - sphi * sphi) / sphi);
+    }
+    return f;
+}
