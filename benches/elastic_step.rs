@@ -10,12 +10,17 @@
 //! element-step with the transfers amortised over GPU_STEPS steps. On lavapipe (Mesa's
 //! software Vulkan) these rows prove that the path works, not GPU speed.
 //!
+//! Mohr–Coulomb rows (`mc_*`): the same blocks with `pcdc_mech::MohrCoulomb` in two
+//! states: `elastic` (strengths far above the stresses: the cost of the yield check) and
+//! `yielding` (confined at 10 MPa and loaded 1 % beyond the triaxial strength by the
+//! initial stress: every element returns to the surface every step, see `sim_mc`).
+//!
 //! Run: `cargo bench --bench elastic_step`. Throughput is reported by criterion as
 //! elements/s (= element-steps/s).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use pcdc_compute::{Backend, Precision, Simulation};
-use pcdc_mech::{Boundary, LinearElastic, Mechanics};
+use pcdc_mech::{Boundary, ConstitutiveModel, FaceStress, LinearElastic, Mechanics, MohrCoulomb};
 use pcdc_mesh::{builders, Dim, Mesh, Range};
 
 /// Steps per measured GPU iteration.
@@ -23,18 +28,75 @@ const GPU_STEPS: u64 = 20;
 
 fn sim<D: Dim>(mesh: Mesh<D>, backend: Backend, bottom: &str, top: &str) -> Simulation<D> {
     let rock = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
+    sim_with(mesh, backend, boundary::<D>(bottom, top), rock, [0.0; 6])
+}
+
+/// Mohr–Coulomb: `yielding` or far from yield. Yielding: c = 1 MPa, φ = 30°, ψ = 5°,
+/// σ_t = 0.5 MPa, confined at −10 MPa by face stresses on the lateral faces and loaded
+/// axially 1 % beyond σ1 = σ3 N_φ + 2c√N_φ by the initial stress, so that every element
+/// returns every step (to the edge σ2 = σ3 of triaxial compression).
+fn sim_mc<D: Dim>(
+    mesh: Mesh<D>,
+    backend: Backend,
+    bottom: &str,
+    top: &str,
+    yielding: bool,
+) -> Simulation<D> {
+    let e = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
+    if yielding {
+        let rock = MohrCoulomb::new(e, 1e6, 30.0, 5.0, 0.5e6).unwrap();
+        let axial = -1.01 * (3.0 * 10e6 + 2.0 * 1e6 * 3f64.sqrt());
+        let mut s0 = [-10e6, -10e6, -10e6, 0.0, 0.0, 0.0];
+        let lateral: &[&str] = if D::D == 2 {
+            s0[1] = axial;
+            &["left", "right"]
+        } else {
+            s0[2] = axial;
+            &["xmin", "xmax", "ymin", "ymax"]
+        };
+        let mut b = boundary::<D>(bottom, top);
+        for name in lateral {
+            b = b.face_stress(
+                Range::group(*name),
+                FaceStress {
+                    normal: Some((-10e6).into()),
+                    ..Default::default()
+                },
+            );
+        }
+        sim_with(mesh, backend, b, rock, s0)
+    } else {
+        let rock = MohrCoulomb::new(e, 1e9, 30.0, 5.0, 1e8).unwrap();
+        sim_with(mesh, backend, boundary::<D>(bottom, top), rock, [0.0; 6])
+    }
+}
+
+/// Bottom held, top pushed at 0.05 m/s along y (2D) or z (3D).
+fn boundary<D: Dim>(bottom: &str, top: &str) -> Boundary {
     let y = if D::D == 2 { 1 } else { 2 };
     let mut push = [None, None, None];
     push[y] = Some((-0.05).into());
     let mut hold = [None, None, None];
     hold[y] = Some(0.0.into());
+    Boundary::new()
+        .velocity(Range::group(bottom), hold)
+        .velocity(Range::group(top), push)
+}
+
+fn sim_with<D: Dim>(
+    mesh: Mesh<D>,
+    backend: Backend,
+    boundary: Boundary,
+    rock: impl ConstitutiveModel + 'static,
+    s0: [f64; 6],
+) -> Simulation<D> {
     Simulation::builder(mesh, backend)
-        .physics(Mechanics::new().material(Range::All, rock))
         .physics(
-            Boundary::new()
-                .velocity(Range::group(bottom), hold)
-                .velocity(Range::group(top), push),
+            Mechanics::new()
+                .material(Range::All, rock)
+                .initial_stress(Range::All, s0),
         )
+        .physics(boundary)
         .build()
         .unwrap()
 }
@@ -67,6 +129,41 @@ fn bench(c: &mut Criterion) {
             format!("tet4_{}k_threads_{t}", s3.mesh().n_elements() / 1000),
             |b| b.iter(|| s3.step().unwrap()),
         );
+        for yielding in [false, true] {
+            let state = if yielding { "yielding" } else { "elastic" };
+            let mut m2 = sim_mc(
+                tri.clone(),
+                Backend::cpu(t).unwrap(),
+                "bottom",
+                "top",
+                yielding,
+            );
+            m2.run(20).unwrap();
+            g.throughput(Throughput::Elements(m2.mesh().n_elements() as u64));
+            g.bench_function(
+                format!(
+                    "mc_tri3_{}k_{state}_threads_{t}",
+                    m2.mesh().n_elements() / 1000
+                ),
+                |b| b.iter(|| m2.step().unwrap()),
+            );
+            let mut m3 = sim_mc(
+                tet.clone(),
+                Backend::cpu(t).unwrap(),
+                "zmin",
+                "zmax",
+                yielding,
+            );
+            m3.run(20).unwrap();
+            g.throughput(Throughput::Elements(m3.mesh().n_elements() as u64));
+            g.bench_function(
+                format!(
+                    "mc_tet4_{}k_{state}_threads_{t}",
+                    m3.mesh().n_elements() / 1000
+                ),
+                |b| b.iter(|| m3.step().unwrap()),
+            );
+        }
     }
     for p in [Precision::F64, Precision::F32] {
         let gpu = match Backend::gpu(Some(p)) {

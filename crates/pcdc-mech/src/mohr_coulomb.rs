@@ -16,7 +16,9 @@
 //! * **Return mapping** \[NOT IN MANUAL: the manual stops at "correct with the potential"\]
 //!   σ^N = σ* − Σ_k λ_k D ∇g_k over an active set of the yield planes of the ordered
 //!   sector, λ_k ≥ 0 from f_k(σ^N) = 0 (the planes are linear in principal space, so each
-//!   set is one small linear solve). The planes: the shear plane of eq. 29, the two
+//!   set is one small linear solve, tried as an active set first: the plane the h-function
+//!   picks, then the most violated plane of each result added, up to three; a search over
+//!   every set is the fallback, so a return is never missed). The planes: the shear plane of eq. 29, the two
 //!   shear planes that meet it where σ2 reaches σ3 or σ1 (the edges of the Mohr–Coulomb
 //!   pyramid), and σ_i = σ_t for each i. One shear plane alone is the digest's (FLAC's)
 //!   formula, λ = F / [α1(1 + N_φ N_ψ) − α2(N_φ + N_ψ)]; σ3 = σ_t alone is its tension
@@ -95,6 +97,9 @@ pub struct MohrCoulomb {
     /// Derived once from the parameters: `update` runs per element per step.
     #[serde(skip_serializing)]
     surfaces: Surfaces,
+    /// λ and 2μ of the elastic part (Pa), derived once.
+    #[serde(skip_serializing)]
+    lame: (f64, f64),
 }
 
 #[derive(Deserialize)]
@@ -252,6 +257,7 @@ impl MohrCoulomb {
                  strength",
             ));
         }
+        let lame = (elastic.lambda(), 2.0 * elastic.shear());
         let mut m = MohrCoulomb {
             elastic,
             cohesion,
@@ -260,6 +266,7 @@ impl MohrCoulomb {
             tensile,
             softening: None,
             surfaces: Surfaces::default(),
+            lame,
         };
         m.surfaces = surfaces_of(&m.elastic, cohesion, friction_deg, dilation_deg, tensile);
         Ok(m)
@@ -348,6 +355,7 @@ fn surfaces_of(e: &LinearElastic, c: f64, phi: f64, psi: f64, st: f64) -> Surfac
         st: tensile_cap(c, phi, st),
         a1: k + 4.0 * g / 3.0,
         a2: k - 2.0 * g / 3.0,
+        alpha_p: (1.0 + n_phi * n_phi).sqrt() + n_phi,
     }
 }
 
@@ -373,10 +381,45 @@ pub struct Surfaces {
     pub a1: f64,
     /// α2 = K − 2G/3 (Pa, eq. 27).
     pub a2: f64,
+    /// α_P = √(1 + N_φ²) + N_φ of the h-function ([`Surfaces::h`]).
+    pub alpha_p: f64,
 }
+
+/// √3, for [`Surfaces::surely_elastic`].
+const SQRT_3: f64 = 1.732_050_807_568_877_2;
 
 /// Number of yield planes in the ordered sector.
 const PLANES: usize = 6;
+
+/// Every set of one, two or three planes as a bit mask (bit k: plane k): singles, pairs
+/// and triples, each in increasing mask order.
+const SETS: [u8; 41] = sets();
+
+const fn sets() -> [u8; 41] {
+    let mut out = [0u8; 41];
+    let mut n = 0;
+    let mut size = 1;
+    while size <= 3 {
+        let mut m = 1u8;
+        while m < 64 {
+            if m.count_ones() == size {
+                out[n] = m;
+                n += 1;
+            }
+            m += 1;
+        }
+        size += 1;
+    }
+    out
+}
+
+/// The sets tried first on the shear side (h ≤ 0): the shear plane, its edges with
+/// σ2 = σ3 and σ2 = σ1 (triaxial compression and extension), the shear–tension corner,
+/// the tension plane.
+const FIRST_SHEAR: [u8; 5] = [0b1, 0b11, 0b101, 0b1001, 0b1000];
+/// The sets tried first on the tension side (h > 0): the tension plane, its edge with
+/// σ2 = σ_t, the corner, the shear plane, the apex σ1 = σ2 = σ3 = σ_t.
+const FIRST_TENSION: [u8; 5] = [0b1000, 0b11000, 0b1001, 0b1, 0b111000];
 
 /// What a return did.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -447,11 +490,29 @@ impl Surfaces {
         (self.n_phi * hi - lo - self.kc).max(hi - self.st)
     }
 
+    /// True when the tensor `t` (xx, yy, zz, xy, yz, xz) lies inside the yield surface by
+    /// a bound that needs no principal decomposition, so that elastic elements skip it:
+    /// with the mean p and the deviator's eigenvalues s_i (Σ s_i = 0, Σ s_i² = s:s),
+    /// s_max ≤ R = √(⅔ s:s) and s_max − s_min ≤ √(2 s:s) = √3 R, hence
+    /// N_φ σ_max − σ_min − 2c√N_φ ≤ (N_φ − 1)(p + R) + √3 R − 2c√N_φ and σ_max ≤ p + R.
+    /// False means "decompose and check", not "plastic".
+    pub fn surely_elastic(&self, t: &Sym6) -> bool {
+        // Squared, so that no square root is taken: r ≤ σ_t − p and
+        // (N_φ − 1 + √3) r ≤ 2c√N_φ − (N_φ − 1) p, both sides non-negative.
+        let p = (t[0] + t[1] + t[2]) * (1.0 / 3.0);
+        let (a, b, c) = (t[0] - p, t[1] - p, t[2] - p);
+        let ss = a * a + b * b + c * c + 2.0 * (t[3] * t[3] + t[4] * t[4] + t[5] * t[5]);
+        let r2 = ss * (2.0 / 3.0);
+        let room_t = self.st - p;
+        let k = self.n_phi - 1.0 + SQRT_3;
+        let room_s = self.kc - (self.n_phi - 1.0) * p;
+        room_t >= 0.0 && room_s >= 0.0 && r2 <= room_t * room_t && k * k * r2 <= room_s * room_s
+    }
+
     /// The digest's h-function (shear domain when ≤ 0).
     pub fn h(&self, s: &[f64; 3]) -> f64 {
-        let ap = (1.0 + self.n_phi * self.n_phi).sqrt() + self.n_phi;
         let sp = self.st * self.n_phi - self.kc;
-        s[2] - self.st + ap * (s[0] - sp)
+        s[2] - self.st + self.alpha_p * (s[0] - sp)
     }
 
     /// Returns the ordered trial principal stresses `s` (σ1 ≤ σ2 ≤ σ3) to the yield
@@ -462,44 +523,56 @@ impl Surfaces {
             return None;
         }
         let tol = 1e-12 * scale.max(f64::MIN_POSITIVE);
-        // Singles (the h-function picks which of shear and tension comes first), then
-        // pairs, then triples; the first admissible set wins, else the least violating.
-        let singles = if self.h(s) <= 0.0 {
-            [0, 3, 1, 2, 4, 5]
+        // Active set: start from the plane the h-function picks (shear or tension), add
+        // the most violated plane of each result, up to three planes.
+        let mut planes = [if self.h(s) <= 0.0 { 0 } else { 3 }, 0, 0];
+        let mut n = 1;
+        while let Some(r) = self.solve(s, &planes[..n]) {
+            if self.composite(&r.stress) <= tol {
+                return Some(r);
+            }
+            if n == 3 {
+                break;
+            }
+            let (mut worst, mut at) = (tol, PLANES);
+            for k in (0..PLANES).filter(|k| !planes[..n].contains(k)) {
+                let f = self.plane(k, &r.stress);
+                if f > worst {
+                    (worst, at) = (f, k);
+                }
+            }
+            if at == PLANES {
+                break;
+            }
+            planes[n] = at;
+            n += 1;
+        }
+        // Otherwise the likely sets first, then every set of one, two and three planes;
+        // the first admissible set wins, else the least violating.
+        let first = if self.h(s) <= 0.0 {
+            &FIRST_SHEAR
         } else {
-            [3, 0, 1, 2, 4, 5]
+            &FIRST_TENSION
         };
         let mut best: Option<(f64, Return)> = None;
-        let mut admissible = |set: &[usize]| -> Option<Return> {
-            let r = self.solve(s, set)?;
+        for &mask in first
+            .iter()
+            .chain(SETS.iter().filter(|m| !first.contains(m)))
+        {
+            let mut n = 0;
+            for (k, p) in (0..PLANES).filter(|k| mask & (1 << k) != 0).zip(0..) {
+                planes[p] = k;
+                n += 1;
+            }
+            let Some(r) = self.solve(s, &planes[..n]) else {
+                continue;
+            };
             let violation = self.composite(&r.stress);
             if violation <= tol {
                 return Some(r);
             }
             if best.is_none_or(|(v, _)| violation < v) {
                 best = Some((violation, r));
-            }
-            None
-        };
-        for k in singles {
-            if let Some(r) = admissible(&[k]) {
-                return Some(r);
-            }
-        }
-        for i in 0..PLANES {
-            for j in i + 1..PLANES {
-                if let Some(r) = admissible(&[i, j]) {
-                    return Some(r);
-                }
-            }
-        }
-        for i in 0..PLANES {
-            for j in i + 1..PLANES {
-                for k in j + 1..PLANES {
-                    if let Some(r) = admissible(&[i, j, k]) {
-                        return Some(r);
-                    }
-                }
             }
         }
         best.map(|(_, r)| r)
@@ -508,7 +581,17 @@ impl Surfaces {
     /// The return onto the planes `set` together: λ from f_k(σ* − Σ_j λ_j D∇g_j) = 0;
     /// `None` when a multiplier is negative or the planes are dependent.
     fn solve(&self, s: &[f64; 3], set: &[usize]) -> Option<Return> {
-        let n = set.len();
+        // Fixed sizes, so that the loops unroll.
+        match *set {
+            [a] => self.solve_n(s, &[a]),
+            [a, b] => self.solve_n(s, &[a, b]),
+            [a, b, c] => self.solve_n(s, &[a, b, c]),
+            _ => None,
+        }
+    }
+
+    fn solve_n<const N: usize>(&self, s: &[f64; 3], set: &[usize; N]) -> Option<Return> {
+        let n = N;
         let mut dg = [[0.0; 3]; 3];
         for (c, &j) in set.iter().enumerate() {
             dg[c] = self.elastic(&self.potential_gradient(j));
@@ -522,7 +605,7 @@ impl Surfaces {
             }
             b[r] = self.plane(k, s);
         }
-        let lambda = solve_small(&a, &b, n)?;
+        let lambda = solve_small::<N>(&a, &b)?;
         if lambda[..n].iter().any(|&l| l < 0.0) {
             return None;
         }
@@ -560,7 +643,8 @@ fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 
 /// Solves the leading n×n block of a x = b (n ≤ 3) by Gaussian elimination with partial
 /// pivoting; `None` if singular.
-fn solve_small(a: &[[f64; 3]; 3], b: &[f64; 3], n: usize) -> Option<[f64; 3]> {
+fn solve_small<const N: usize>(a: &[[f64; 3]; 3], b: &[f64; 3]) -> Option<[f64; 3]> {
+    let n = N;
     let (mut a, mut b) = (*a, *b);
     let norm = a
         .iter()
@@ -619,11 +703,13 @@ impl ConstitutiveModel for MohrCoulomb {
         MC_STATE
     }
     fn update(&self, _strain: &Sym6, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) {
-        let e = &self.elastic;
-        add_hooke(e.lambda(), 2.0 * e.shear(), de, stress);
+        add_hooke(self.lame.0, self.lame.1, de, stress);
         st[state::SHEAR_NOW] = 0.0;
         st[state::TENSION_NOW] = 0.0;
         let surfaces = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
+        if surfaces.surely_elastic(stress) {
+            return;
+        }
         let p = principal(stress);
         let Some(r) = surfaces.return_map(&p.values) else {
             return;
@@ -634,7 +720,7 @@ impl ConstitutiveModel for MohrCoulomb {
             st[state::SHEAR_PAST] = 1.0;
             // FLAC's shear hardening parameter from the shear planes' plastic strain.
             let ep = r.shear_strain;
-            let m = (ep[0] + ep[2]) / 3.0;
+            let m = (ep[0] + ep[2]) * (1.0 / 3.0);
             st[state::SHEAR_STRAIN] +=
                 (0.5 * ((ep[0] - m).powi(2) + m * m + (ep[2] - m).powi(2))).sqrt();
         }
@@ -645,10 +731,10 @@ impl ConstitutiveModel for MohrCoulomb {
         }
     }
     fn wgsl(&self) -> Option<WgslModel> {
-        let (e, f) = (&self.elastic, &self.surfaces);
+        let f = &self.surfaces;
         let mut params = vec![
-            e.lambda(),
-            e.shear(),
+            self.lame.0,
+            self.lame.1,
             f.a1,
             f.a2,
             f.n_phi,
@@ -662,6 +748,7 @@ impl ConstitutiveModel for MohrCoulomb {
             self.friction,
             self.dilation,
             self.tensile,
+            f.alpha_p,
         ];
         match &self.softening {
             Some(soft) => soft.wgsl_params(&mut params),

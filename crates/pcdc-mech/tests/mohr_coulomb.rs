@@ -181,6 +181,16 @@ proptest! {
         prop_assert_eq!(r.shear, 0.0);
     }
 
+    /// The decomposition-free elastic bound never calls a plastic state elastic.
+    #[test]
+    fn surely_elastic_is_never_wrong(m in params(), t in tensor(1.0), k in 0.1..30.0f64) {
+        let s = m.surfaces();
+        let t = t.map(|v| v * k * s.kc);
+        if s.surely_elastic(&t) {
+            prop_assert!(s.composite(&principal(&t).values) <= 0.0, "{:?}", t);
+        }
+    }
+
     /// With ψ = 0 the shear planes' plastic flow keeps the volume.
     #[test]
     fn zero_dilation_keeps_plastic_volume(m in params(), t in tensor(1.0)) {

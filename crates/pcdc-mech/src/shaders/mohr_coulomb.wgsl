@@ -2,8 +2,7 @@
 // (eq. 25-28), principal decomposition, active-set return (eq. 29 corrected, 30-33),
 // history: 0 shear now, 1 shear past, 2 tension now, 3 tension past, 4 κ_s, 5 κ_t.
 let l = param(p, 0u);
-let mu = param(p, 1u);
-let two_mu = 2.0 * mu;
+let two_mu = param(p, 1u);
 let tr = dstrain[0] + dstrain[1] + dstrain[2];
 var s = stress;
 s[0] = s[0] + (l * tr + two_mu * dstrain[0]);
@@ -15,6 +14,9 @@ s[5] = s[5] + two_mu * dstrain[5];
 (*state)[0] = 0.0;
 (*state)[2] = 0.0;
 let f = mc_surfaces(p, (*state)[4], (*state)[5]);
+if mc_surely_elastic(f, s) {
+    return s;
+}
 let pr = mc_principal(s, param(p, 8u));
 let r = mc_return(f, pr.values, param(p, 9u));
 if !r.ok {
@@ -23,7 +25,7 @@ if !r.ok {
 if r.shear > 0.0 {
     (*state)[0] = 1.0;
     (*state)[1] = 1.0;
-    let m = (r.eps[0] + r.eps[2]) / 3.0;
+    let m = (r.eps[0] + r.eps[2]) * (1.0 / 3.0);
     (*state)[4] = (*state)[4] + sqrt(0.5 * ((r.eps[0] - m) * (r.eps[0] - m) + m * m + (r.eps[2] - m) * (r.eps[2] - m)));
 }
 if r.tension > 0.0 {

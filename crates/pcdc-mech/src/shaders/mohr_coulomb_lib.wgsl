@@ -1,8 +1,9 @@
 // Mohr–Coulomb with tension cut-off (manual 7.2.4): the helpers of the model body, the
 // operations of mohr_coulomb.rs and principal.rs in the same order, so that f64 matches
-// the CPU to rounding. Parameters (param(p, k)): 0 λ, 1 μ (Pa), 2 α1, 3 α2 (Pa), 4 N_φ,
-// 5 N_ψ, 6 2c√N_φ (Pa), 7 σ_t (Pa), 8 the Jacobi stop (1e-300), 9 f64::MIN_POSITIVE,
-// 10 softening (0/1), 11 c (Pa), 12 φ, 13 ψ (degrees), 14 σ_t as given (Pa), then four
+// the CPU to rounding. Parameters (param(p, k)): 0 λ, 1 2μ (Pa), 2 α1, 3 α2 (Pa), 4 N_φ,
+// 5 N_ψ, 6 2c√N_φ (Pa), 7 σ_t (Pa), 8 the Jacobi stop (1e-32), 9 f64::MIN_POSITIVE,
+// 10 softening (0/1), 11 c (Pa), 12 φ, 13 ψ (degrees), 14 σ_t as given (Pa), 15 α_P of
+// the h-function, then four
 // tables (c, φ, ψ against κ_s; σ_t against κ_t), each its point count n, n abscissae and
 // n values (n = 0: the constant).
 alias McV3 = array<Real, 3>;
@@ -14,6 +15,7 @@ struct McSurf {
     st: Real,
     a1: Real,
     a2: Real,
+    alpha_p: Real,
 }
 
 struct McRet {
@@ -73,10 +75,23 @@ fn mc_composite(f: McSurf, s: McV3) -> Real {
     return max(f.n_phi * hi - lo - f.kc, hi - f.st);
 }
 
+// Surfaces::surely_elastic: inside by a bound without the decomposition.
+fn mc_surely_elastic(f: McSurf, t: Sym) -> bool {
+    let p = (t[0] + t[1] + t[2]) * (1.0 / 3.0);
+    let a = t[0] - p;
+    let b = t[1] - p;
+    let c = t[2] - p;
+    let ss = a * a + b * b + c * c + 2.0 * (t[3] * t[3] + t[4] * t[4] + t[5] * t[5]);
+    let r2 = ss * (2.0 / 3.0);
+    let room_t = f.st - p;
+    let k = f.n_phi - 1.0 + 1.7320508075688772;
+    let room_s = f.kc - (f.n_phi - 1.0) * p;
+    return room_t >= 0.0 && room_s >= 0.0 && r2 <= room_t * room_t && k * k * r2 <= room_s * room_s;
+}
+
 fn mc_h(f: McSurf, s: McV3) -> Real {
-    let ap = sqrt(1.0 + f.n_phi * f.n_phi) + f.n_phi;
     let sp = f.st * f.n_phi - f.kc;
-    return s[2] - f.st + ap * (s[0] - sp);
+    return s[2] - f.st + f.alpha_p * (s[0] - sp);
 }
 
 // The return onto planes[0..n] together (Surfaces::solve).
@@ -194,32 +209,74 @@ fn mc_return(f: McSurf, s: McV3, min_pos: Real) -> McRet {
         return found;
     }
     let tol = 1e-12 * max(scale, min_pos);
-    var singles = array<u32, 6>(0u, 3u, 1u, 2u, 4u, 5u);
+    // Active set from the h-function's plane, adding the most violated plane.
+    var planes = array<u32, 3>(0u, 0u, 0u);
     if mc_h(f, s) > 0.0 {
-        singles = array<u32, 6>(3u, 0u, 1u, 2u, 4u, 5u);
+        planes[0] = 3u;
     }
+    for (var n = 1u; n <= 3u; n = n + 1u) {
+        let r = mc_solve(f, s, planes, n);
+        if !r.ok {
+            break;
+        }
+        if mc_composite(f, r.s) <= tol {
+            return r;
+        }
+        if n == 3u {
+            break;
+        }
+        var worst = tol;
+        var at = 6u;
+        for (var k = 0u; k < 6u; k = k + 1u) {
+            var used = false;
+            for (var j = 0u; j < n; j = j + 1u) {
+                used = used || planes[j] == k;
+            }
+            let fk = mc_plane(f, k, r.s);
+            if !used && fk > worst {
+                worst = fk;
+                at = k;
+            }
+        }
+        if at == 6u {
+            break;
+        }
+        planes[n] = at;
+    }
+    // Otherwise the likely sets first, then every set (Surfaces::return_map:
+    // FIRST_SHEAR, FIRST_TENSION, SETS as bit masks).
+    var first = array<u32, 5>(1u, 3u, 5u, 9u, 8u);
+    if mc_h(f, s) > 0.0 {
+        first = array<u32, 5>(8u, 24u, 9u, 1u, 56u);
+    }
+    var sets = array<u32, 41>(1u, 2u, 4u, 8u, 16u, 32u, 3u, 5u, 6u, 9u, 10u, 12u, 17u, 18u, 20u, 24u, 33u, 34u, 36u, 40u, 48u, 7u, 11u, 13u, 14u, 19u, 21u, 22u, 25u, 26u, 28u, 35u, 37u, 38u, 41u, 42u, 44u, 49u, 50u, 52u, 56u);
     var best: McRet;
     best.ok = false;
     var best_v = Real(0.0);
-    for (var i = 0u; i < 6u; i = i + 1u) {
-        if mc_try(f, s, array<u32, 3>(singles[i], 0u, 0u), 1u, tol, &found, &best, &best_v) {
+    for (var i = 0u; i < 46u; i = i + 1u) {
+        var mask = 0u;
+        if i < 5u {
+            mask = first[i];
+        } else {
+            mask = sets[i - 5u];
+            var tried = false;
+            for (var k = 0u; k < 5u; k = k + 1u) {
+                tried = tried || first[k] == mask;
+            }
+            if tried {
+                continue;
+            }
+        }
+        planes = array<u32, 3>(0u, 0u, 0u);
+        var n = 0u;
+        for (var k = 0u; k < 6u; k = k + 1u) {
+            if (mask & (1u << k)) != 0u {
+                planes[n] = k;
+                n = n + 1u;
+            }
+        }
+        if mc_try(f, s, planes, n, tol, &found, &best, &best_v) {
             return found;
-        }
-    }
-    for (var i = 0u; i < 6u; i = i + 1u) {
-        for (var j = i + 1u; j < 6u; j = j + 1u) {
-            if mc_try(f, s, array<u32, 3>(i, j, 0u), 2u, tol, &found, &best, &best_v) {
-                return found;
-            }
-        }
-    }
-    for (var i = 0u; i < 6u; i = i + 1u) {
-        for (var j = i + 1u; j < 6u; j = j + 1u) {
-            for (var k = j + 1u; k < 6u; k = k + 1u) {
-                if mc_try(f, s, array<u32, 3>(i, j, k), 3u, tol, &found, &best, &best_v) {
-                    return found;
-                }
-            }
         }
     }
     return best;
@@ -265,7 +322,12 @@ fn mc_rotate(a: ptr<function, array<McV3, 3>>, v: ptr<function, array<McV3, 3>>,
 fn mc_principal(t: Sym, jtol: Real) -> McPrin {
     var a = array<McV3, 3>(McV3(t[0], t[3], t[5]), McV3(t[3], t[1], t[4]), McV3(t[5], t[4], t[2]));
     var v = array<McV3, 3>(McV3(1.0, 0.0, 0.0), McV3(0.0, 1.0, 0.0), McV3(0.0, 0.0, 1.0));
-    for (var sweep = 0u; sweep < 12u; sweep = sweep + 1u) {
+    var sweeps = 12u;
+    if t[4] == 0.0 && t[5] == 0.0 {
+        mc_rotate(&a, &v, 0u, 1u);
+        sweeps = 0u;
+    }
+    for (var sweep = 0u; sweep < sweeps; sweep = sweep + 1u) {
         let off = a[0][1] * a[0][1] + a[1][2] * a[1][2] + a[0][2] * a[0][2];
         let diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
         if off <= jtol * diag || off == 0.0 {
@@ -332,7 +394,7 @@ fn mc_sin(x: Real) -> Real {
 // Table k (0 c, 1 φ, 2 ψ, 3 σ_t) at x, or `fallback` without points: linear between
 // points, constant beyond (pcdc_compute::Table::eval).
 fn mc_table(p: u32, k: u32, x: Real, fallback: Real) -> Real {
-    var at = 15u;
+    var at = 16u;
     for (var j = 0u; j < k; j = j + 1u) {
         at = at + 1u + 2u * u32(param(p, at));
     }
@@ -361,7 +423,7 @@ fn mc_table(p: u32, k: u32, x: Real, fallback: Real) -> Real {
 
 // The surfaces at the element's plastic strains (MohrCoulomb::surfaces_at).
 fn mc_surfaces(p: u32, ks: Real, kt: Real) -> McSurf {
-    var f = McSurf(param(p, 4u), param(p, 5u), param(p, 6u), param(p, 7u), param(p, 2u), param(p, 3u));
+    var f = McSurf(param(p, 4u), param(p, 5u), param(p, 6u), param(p, 7u), param(p, 2u), param(p, 3u), param(p, 15u));
     if param(p, 10u) == 0.0 {
         return f;
     }
@@ -374,6 +436,7 @@ fn mc_surfaces(p: u32, ks: Real, kt: Real) -> McSurf {
     f.n_phi = (1.0 + sphi) / (1.0 - sphi);
     f.n_psi = (1.0 + spsi) / (1.0 - spsi);
     f.kc = 2.0 * c * sqrt(f.n_phi);
+    f.alpha_p = sqrt(1.0 + f.n_phi * f.n_phi) + f.n_phi;
     f.st = st;
     if phi > 0.0 {
         f.st = min(st, c * sqrt(1.0 - sphi * sphi) / sphi);
