@@ -303,3 +303,36 @@ fn triaxial_yield_and_dilatancy_follow_mohr_coulomb() {
         );
     }
 }
+
+/// Scene 5: Burgers creep under a constant deviator, plane strain and 3D, with the
+/// Crank–Nicolson order shown by halving the creep step.
+#[test]
+fn burgers_creep_follows_the_closed_form_to_second_order() {
+    use pcdc_validation::scenes::creep::{self, Dimension};
+    let cpu = cpu();
+    for dim in [Dimension::Two, Dimension::Three] {
+        let p = creep::Params::reduced(dim);
+        let a = creep::run(&cpu, &p).unwrap();
+        // The order at small strain (see `scenes::creep`: the large-strain floor).
+        let small = creep::Params {
+            tau: creep::TAU_CONVERGENCE,
+            ..p.clone()
+        };
+        let a_small = creep::run(&cpu, &small).unwrap();
+        let b = creep::run(
+            &cpu,
+            &creep::Params {
+                steps: 2 * p.steps,
+                ..small
+            },
+        )
+        .unwrap();
+        let order = (a_small.error / b.error).log2();
+        eprintln!(
+            "creep {dim:?}: error {:.3e} ({} steps); at 1 kPa {:.3e}, {:.3e} ({}), order {order:.2}; {} elements",
+            a.error, p.steps, a_small.error, b.error, 2 * p.steps, a.elements
+        );
+        assert!(a.error <= creep::TOL, "{dim:?}: {}", a.error);
+        assert!(order > 1.9, "{dim:?}: order {order}");
+    }
+}

@@ -27,7 +27,8 @@
 //! | eq. 15–16 | body force and lumped mass `ρV/(N+1)` per node | `Mechanics`, gravity in `Simulation` |
 //! | eq. 17–19 | viscous stress `σ_v = D_f C ε̇`, `C = 2L√(ρE)`, L = mean edge length | `Mechanics` |
 //! | eq. 20–24 | isotropic linear elasticity, λ and μ from E, ν (or K, G) | [`LinearElastic`] |
-//! | eq. 25–33 (29 \[CORRECTED\]), table 2 | Mohr–Coulomb with tension cut-off, non-associated shear flow, return mapping over the pyramid's planes, edges and the shear–tension corner | [`MohrCoulomb`], [`mohr_coulomb`], [`principal`] |
+//! | eq. 25–33 (29 \[CORRECTED\]), table 2 | Mohr–Coulomb with tension cut-off, non-associated shear flow, return mapping over the pyramid's planes, edges and the shear–tension corner (CPU and WGSL); strain softening of c, φ, ψ, σ_t \[NOT IN MANUAL\] | [`MohrCoulomb`], [`Softening`], [`mohr_coulomb`], [`principal`] |
+//! | eq. 34–48 (47–48 \[CORRECTED\]), table 3 | Burgers creep in deviatoric tensor form, Crank–Nicolson, with a creep clock and creep steps relaxed to equilibrium | [`Burgers`], [`CreepClock`], [`creep_step`], [`burgers`] |
 //! | tables 4–7 | velocity/acceleration, force, face stress, move constraints | [`Boundary`] |
 //!
 //! The stable step of an element is `κ h / c_p` with h its smallest height, c_p the
@@ -121,6 +122,7 @@
 
 pub mod actions;
 mod boundary;
+pub mod burgers;
 mod error;
 pub mod kinematics;
 mod mechanics;
@@ -131,6 +133,7 @@ pub mod principal;
 
 pub use actions::{reset_displacement, reset_element_state, reset_velocity, set_velocity};
 pub use boundary::{Boundary, Components, Constraint, FaceStress, ACCEL_VELOCITY};
+pub use burgers::{creep_step, creep_time, Burgers, CreepClock, CREEP_CLOCK};
 pub use error::MechError;
 pub use mechanics::{Mechanics, SurfaceProperties};
 pub use model::{double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};

@@ -1226,6 +1226,36 @@ mod gpu_tests {
     }
 
     #[test]
+    fn burgers_kernels_validate_with_naga() {
+        use crate::burgers::{Burgers, CreepClock};
+        let e = LinearElastic::new(1e9, 0.25, 2500.0).unwrap();
+        let b = Burgers::new(e, 2e9, 1e12, 1e13).unwrap();
+        let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
+        let m3 = builders::cuboid([0.0; 3], [1.0; 3], 0.5).unwrap();
+        for p in [Precision::F64, Precision::F32] {
+            fn physics<D: Dim>(b: &Burgers) -> Vec<Box<dyn Physics<D>>> {
+                vec![
+                    Box::new(Mechanics::new().material(Range::All, b.clone()).material(
+                        Range::Ball {
+                            center: [0.0; 3],
+                            radius: 0.6,
+                        },
+                        LinearElastic::new(2e9, 0.2, 2600.0).unwrap(),
+                    )),
+                    Box::new(CreepClock::new(&[b], 0.1).unwrap()),
+                ]
+            }
+            let s2 = offline_kernel_sources::<_>(&m2, physics(&b), p).unwrap();
+            let s3 = offline_kernel_sources::<_>(&m3, physics(&b), p).unwrap();
+            for (label, src) in s2.iter().chain(&s3) {
+                if let Err(e) = validate_wgsl(src) {
+                    panic!("{label} ({}) does not validate:\n{e}", p.name());
+                }
+            }
+        }
+    }
+
+    #[test]
     fn model_without_wgsl_is_a_build_error_naming_it() {
         let m2 = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
         let mech = Mechanics::new().material(Range::All, CpuOnly);

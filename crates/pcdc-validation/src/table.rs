@@ -16,7 +16,7 @@ use pcdc_compute::{Backend, BackendKind, Precision};
 use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
-    block_sliding, brazilian, direct_tension, fracture_flow, injection, kirsch, radial_flow,
+    block_sliding, brazilian, creep, direct_tension, fracture_flow, injection, kirsch, radial_flow,
     triaxial, ucs, unconfined_flow, vibration_energy, wave_speed,
 };
 
@@ -126,6 +126,7 @@ pub const CASES: &[&str] = &[
     "unconfined_flow",
     "injection",
     "triaxial",
+    "creep",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -232,7 +233,13 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("injection", "mass balance", size));
             }
         }
-        // A homogeneous block: the mesh changes the cost, not the closed form.
+        // Homogeneous blocks: the mesh changes the cost, not the closed form.
+        "creep" => {
+            for size in [0.05, 0.025, 0.0125] {
+                out.push(j("creep", "2d", size));
+                out.push(j("creep", "3d", size));
+            }
+        }
         "triaxial" => {
             for size in [0.0125, 0.0075, 0.005] {
                 out.push(j("triaxial", "2d", size));
@@ -359,6 +366,19 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
                 vibration_energy::run_3d(backend, &p)?
             };
             within(o.elements, o.drift, vibration_energy::TOL, o.steps)
+        }
+        "creep" => {
+            let dim = if job.variant == "2d" {
+                creep::Dimension::Two
+            } else {
+                creep::Dimension::Three
+            };
+            let p = creep::Params {
+                size: job.size,
+                ..creep::Params::full(dim)
+            };
+            let o = creep::run(backend, &p)?;
+            within(o.elements, o.error, creep::TOL, o.steps)
         }
         "triaxial" => {
             let dim = if job.variant == "2d" {

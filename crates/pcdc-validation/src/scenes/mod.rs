@@ -12,6 +12,7 @@
 pub mod benchmark;
 pub mod block_sliding;
 pub mod brazilian;
+pub mod creep;
 pub mod direct_tension;
 pub mod file;
 pub mod fracture_flow;
