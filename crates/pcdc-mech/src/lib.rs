@@ -124,6 +124,7 @@ pub mod actions;
 mod boundary;
 pub mod burgers;
 mod error;
+pub mod initial_stress;
 pub mod kinematics;
 mod mechanics;
 mod model;
@@ -135,6 +136,7 @@ pub use actions::{reset_displacement, reset_element_state, reset_velocity, set_v
 pub use boundary::{Boundary, Components, Constraint, FaceStress, ACCEL_VELOCITY};
 pub use burgers::{creep_step, creep_time, Burgers, CreepClock, CREEP_CLOCK};
 pub use error::MechError;
+pub use initial_stress::InitialStress;
 pub use mechanics::{Mechanics, SurfaceProperties};
 pub use model::{double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};
 pub use mohr_coulomb::{MohrCoulomb, Softening};

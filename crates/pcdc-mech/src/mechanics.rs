@@ -24,6 +24,7 @@ use pcdc_compute::{Entity, EntityKind};
 use pcdc_mesh::{Dim, Mesh, Range};
 use rayon::prelude::*;
 
+use crate::initial_stress::InitialStress;
 use crate::kinematics::{dm_inv_2d, polar_2d_h, polar_3d};
 use crate::model::{add_hooke, double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6};
 use crate::MechError;
@@ -72,7 +73,7 @@ pub struct SurfaceProperties {
 #[derive(Debug, Default)]
 pub struct Mechanics {
     assignments: Vec<Assignment>,
-    initial_stress: Vec<(Range, Sym6)>,
+    initial_stress: Vec<(Range, InitialStress)>,
     models: Vec<Arc<dyn ConstitutiveModel>>,
     /// Per model (as `models`): the constants the element loop reads.
     consts: Vec<ModelConsts>,
@@ -137,7 +138,17 @@ impl Mechanics {
     /// Initial stress (Pa, tension positive; xx, yy, zz, xy, yz, xz) of the elements in
     /// `range` (manual chapter 4, item 8); later calls override earlier ones.
     pub fn initial_stress(mut self, range: Range, stress: Sym6) -> Self {
-        self.initial_stress.push((range, stress));
+        self.initial_stress
+            .push((range, InitialStress::Uniform(stress)));
+        self
+    }
+
+    /// An initial stress field (geostatic with K0, a depth gradient, principal values at
+    /// an angle, see [`InitialStress`]) in the elements of `range`, evaluated at their
+    /// centroids; later calls override earlier ones. Checked when the simulation is
+    /// built.
+    pub fn initial_stress_field(mut self, range: Range, field: InitialStress) -> Self {
+        self.initial_stress.push((range, field));
         self
     }
 
@@ -713,24 +724,20 @@ impl<D: Dim> Physics<D> for Mechanics {
                 r.copy_from_slice(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
             }
         }
-        for (range, s0) in &self.initial_stress {
+        for (range, field) in &self.initial_stress {
             let sel = mesh.select_elements(range).map_err(MechError::from)?;
-            if s0.iter().any(|v| !v.is_finite()) {
-                return Err(MechError::param(
-                    "initial stress",
-                    format!("{s0:?}"),
-                    "must be finite",
-                )
-                .into());
-            }
+            field.check()?;
             let [st, zz] = ctx.fields.get_many_mut([stress, extra]);
+            let mut c = [0.0; 3];
             for e in sel {
                 let e = e as usize;
+                mesh.element_centroid(e, &mut c[..D::D]);
+                let s0 = field.at(&c, D::D);
                 if D::D == 2 {
                     st[3 * e..3 * e + 3].copy_from_slice(&[s0[0], s0[1], s0[3]]);
                     zz[e] = s0[2];
                 } else {
-                    st[6 * e..6 * e + 6].copy_from_slice(s0);
+                    st[6 * e..6 * e + 6].copy_from_slice(&s0);
                 }
             }
         }
