@@ -336,3 +336,37 @@ fn burgers_creep_follows_the_closed_form_to_second_order() {
         assert!(order > 1.9, "{dim:?}: order {order}");
     }
 }
+
+/// A circular opening in Mohr–Coulomb rock under hydrostatic stress: Salençon's
+/// stresses and plastic radius.
+#[test]
+fn tunnel_in_mohr_coulomb_rock_follows_salencon() {
+    use pcdc_validation::scenes::tunnel;
+    let o = tunnel::run(&cpu(), &tunnel::Params::reduced()).unwrap();
+    eprintln!(
+        "tunnel: stress error {:.4}, plastic radius {:.3} m vs {:.3} m ({:.4}), {} elements, {} steps, {:.1} s",
+        o.error,
+        o.plastic_radius,
+        o.plastic_radius_exact,
+        o.radius_error(),
+        o.elements,
+        o.steps,
+        o.wall_s
+    );
+    for (r, (st, sr)) in o.r_over_a.iter().zip(o.sigma_theta.iter().zip(&o.sigma_r)) {
+        let (et, er) = tunnel::exact(*r);
+        eprintln!(
+            "  r/a {r:.3}: σθ {:.3} vs {:.3}, σr {:.3} vs {:.3} MPa",
+            st * 1e-6,
+            et * 1e-6,
+            sr * 1e-6,
+            er * 1e-6
+        );
+    }
+    assert!(o.error <= tunnel::TOL, "stress error {}", o.error);
+    assert!(
+        o.radius_error() <= tunnel::RADIUS_TOL,
+        "radius error {}",
+        o.radius_error()
+    );
+}

@@ -323,6 +323,12 @@ impl MohrCoulomb {
     pub fn tensile_effective(&self) -> f64 {
         tensile_cap(self.cohesion, self.friction, self.tensile)
     }
+    /// True when the given σ_t lies above c / tan φ and the model uses the cap instead
+    /// ([`Self::tensile_effective`]): check it (or print it) after building a model from
+    /// user input, as the cap changes the strength the user asked for.
+    pub fn tensile_is_capped(&self) -> bool {
+        self.tensile_effective() < self.tensile
+    }
     /// Uniaxial compressive strength 2c √N_φ (Pa).
     pub fn ucs(&self) -> f64 {
         2.0 * self.cohesion * n_of(self.friction).sqrt()

@@ -61,6 +61,8 @@ fn tension_returns_sigma3_to_the_tensile_strength() {
 fn tensile_strength_is_capped_at_c_cot_phi() {
     let m = model(1e6, 45.0, 0.0, 5e6);
     assert!((m.tensile_effective() - 1e6).abs() < 1e-6);
+    assert!(m.tensile_is_capped());
+    assert!(!model(1e6, 45.0, 0.0, 0.5e6).tensile_is_capped());
     assert_eq!(model(1e6, 0.0, 0.0, 5e6).tensile_effective(), 5e6);
 }
 

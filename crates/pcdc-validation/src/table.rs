@@ -17,7 +17,7 @@ use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
     block_sliding, brazilian, creep, direct_tension, fracture_flow, injection, kirsch, radial_flow,
-    triaxial, ucs, unconfined_flow, vibration_energy, wave_speed,
+    triaxial, tunnel, ucs, unconfined_flow, vibration_energy, wave_speed,
 };
 
 /// One measured row of the report.
@@ -127,6 +127,7 @@ pub const CASES: &[&str] = &[
     "injection",
     "triaxial",
     "creep",
+    "tunnel",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -231,6 +232,11 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
         "injection" => {
             for size in [0.04, 0.03, injection::Params::full().size] {
                 out.push(j("injection", "mass balance", size));
+            }
+        }
+        "tunnel" => {
+            for size in [0.05, 1.0 / 30.0, tunnel::Params::full().size_at_hole] {
+                out.push(j("tunnel", "Salençon", size));
             }
         }
         // Homogeneous blocks: the mesh changes the cost, not the closed form.
@@ -366,6 +372,25 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
                 vibration_energy::run_3d(backend, &p)?
             };
             within(o.elements, o.drift, vibration_energy::TOL, o.steps)
+        }
+        "tunnel" => {
+            let p = tunnel::Params {
+                size_at_hole: job.size,
+                vtu_dir: None,
+            };
+            let o = tunnel::run(backend, &p)?;
+            row(
+                o.elements,
+                o.error,
+                format!(
+                    "{} % of max σθ; plastic radius {} % (measured {:.2} %)",
+                    tunnel::TOL * 100.0,
+                    tunnel::RADIUS_TOL * 100.0,
+                    o.radius_error() * 100.0
+                ),
+                o.error <= tunnel::TOL && o.radius_error() <= tunnel::RADIUS_TOL,
+                o.steps,
+            )
         }
         "creep" => {
             let dim = if job.variant == "2d" {

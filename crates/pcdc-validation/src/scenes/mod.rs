@@ -23,6 +23,7 @@ pub mod limits;
 pub mod platen_test;
 pub mod radial_flow;
 pub mod triaxial;
+pub mod tunnel;
 pub mod ucs;
 pub mod unconfined_flow;
 pub mod vibration_energy;
