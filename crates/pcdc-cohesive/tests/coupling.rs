@@ -335,6 +335,7 @@ fn no_coupling_declares_and_gathers_nothing() {
             "stress_zz",
             "model_state",
             "displacement_reset",
+            "element_null",
             "joint_state",
             "joint_damage",
             "broken_face",

@@ -39,6 +39,11 @@ pub mod names {
     /// Owner: mechanics.
     pub const MODEL_STATE: FieldKey =
         FieldKey::new("model_state", Place::Element, Components::Declared);
+    /// 1 for an element switched to the null model (manual 7.2.8: excavated, it has no
+    /// stiffness, mass, gravity or stress), 0 for a live one. Owner: mechanics
+    /// (`pcdc_mech::set_null`).
+    pub const ELEMENT_NULL: FieldKey =
+        FieldKey::new("element_null", Place::Element, Components::Fixed(1));
     /// Normal opening of each joint, one per interface of the split mesh in its order
     /// (`pcdc_mesh::Mesh::interfaces`): o = δ̄·n (m), δ̄ the mean gap of the node pairs,
     /// n the unit normal below; positive when open. Owner: cohesive joints.

@@ -774,6 +774,41 @@ impl<D: Dim> Simulation<D> {
         Ok(())
     }
 
+    /// Recomputes the lumped node masses from the physics, after a stage that changed
+    /// them (elements switched to the null model, manual 7.2.8), and the stable step.
+    /// A mesh node left without mass (every element around it null) drops out: its
+    /// physical mass and velocity become zero, so that neither gravity nor motion acts
+    /// on it, and it integrates with a unit mass, which only a force could move (no
+    /// element gives it one). Nodes that physics added (bolt nodes) keep their masses.
+    /// Returns the number of mesh nodes that dropped out.
+    pub fn refresh_mass(&mut self) -> Result<usize, ComputeError> {
+        let nm = self.mesh.n_nodes();
+        let mut mass = vec![0.0; self.mass_phys.len()];
+        mass[nm..].copy_from_slice(&self.mass_phys[nm..]);
+        for p in &self.physics {
+            p.add_mass(&self.mesh, &self.state.fields, &mut mass, None);
+        }
+        let d = D::D;
+        let mut out = 0;
+        for (n, m) in mass.iter().enumerate().take(nm) {
+            if *m == 0.0 {
+                out += 1;
+                self.state.v[n * d..(n + 1) * d].fill(0.0);
+            }
+        }
+        self.mass_phys = mass;
+        self.mass = self.integration_mass(&self.mass_phys);
+        self.device_fresh = false;
+        self.update_time_step()?;
+        Ok(out)
+    }
+
+    /// The masses the integration divides by: `m`, with a unit mass where it is zero
+    /// (nodes that dropped out, [`Self::refresh_mass`]).
+    pub(crate) fn integration_mass(&self, m: &[f64]) -> Vec<f64> {
+        m.iter().map(|&x| if x == 0.0 { 1.0 } else { x }).collect()
+    }
+
     /// Lumped nodal mass (kg), one value per node.
     pub fn mass(&self) -> &[f64] {
         &self.mass

@@ -107,7 +107,8 @@ impl<D: Dim> Simulation<D> {
         for p in &self.physics {
             p.add_mass(&self.mesh, &self.state.fields, &mut scaled, Some(1.0 / 0.9));
         }
-        self.mass = scaled;
+        // Nodes that dropped out (no mass) keep a unit integration mass.
+        self.mass = self.integration_mass(&scaled);
         self.damping = false;
         let saved_alpha = self.local_damping;
         self.local_damping = RELAX_DAMPING;
@@ -122,7 +123,7 @@ impl<D: Dim> Simulation<D> {
             t
         });
         self.device_fresh = false;
-        self.mass = self.mass_phys.clone();
+        self.mass = self.integration_mass(&self.mass_phys);
         self.local_damping = saved_alpha;
         self.dt = saved_dt;
         self.damping = saved_damping;

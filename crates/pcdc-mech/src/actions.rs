@@ -89,3 +89,44 @@ pub fn reset_element_state<D: Dim>(
     }
     Ok(elems.len())
 }
+
+/// Switches the elements in `range` to the null model (manual 7.2.8, `element c-model
+/// null`): they lose their stiffness, mass, gravity and stress (stress, strain and
+/// history are zeroed), and mesh nodes left with no live element drop out
+/// ([`pcdc_compute::Simulation::refresh_mass`]); the stable step is recomputed from the
+/// live elements. The remaining elements keep their stresses, so the unloading comes
+/// from the missing internal forces, as in an excavation. Returns the number of
+/// elements switched (already null ones included).
+///
+/// Joints and contact do not yet know null elements, so a simulation that has either
+/// (a physics named "cohesive joints" or "contact") is refused rather than run with
+/// joints to excavated elements still holding.
+pub fn set_null<D: Dim>(sim: &mut Simulation<D>, range: &Range) -> Result<usize, MechError> {
+    if let Some(p) = sim
+        .physics_names()
+        .into_iter()
+        .find(|n| n.contains("joint") || n.contains("contact"))
+    {
+        return Err(MechError::param(
+            "null model",
+            p,
+            "is composed: joints and contact do not yet skip null elements, so excavation \
+             is limited to continuum scenes",
+        ));
+    }
+    let elems = sim.mesh().select_elements(range)?;
+    let id = sim.state.fields.id(names::ELEMENT_NULL)?;
+    let null = sim.state.fields.get_mut(id);
+    for &e in &elems {
+        null[e as usize] = 1.0;
+    }
+    reset_element_state(sim, range)?;
+    let strain = sim.state.fields.id(names::STRAIN)?;
+    let nsym = D::NSYM;
+    let s = sim.state.fields.get_mut(strain);
+    for &e in &elems {
+        s[e as usize * nsym..(e as usize + 1) * nsym].fill(0.0);
+    }
+    sim.refresh_mass()?;
+    Ok(elems.len())
+}

@@ -29,6 +29,7 @@
 //! | eq. 20–24 | isotropic linear elasticity, λ and μ from E, ν (or K, G) | [`LinearElastic`] |
 //! | eq. 25–33 (29 \[CORRECTED\]), table 2 | Mohr–Coulomb with tension cut-off, non-associated shear flow, return mapping over the pyramid's planes, edges and the shear–tension corner (CPU and WGSL); strain softening of c, φ, ψ, σ_t \[NOT IN MANUAL\] | [`MohrCoulomb`], [`Softening`], [`mohr_coulomb`], [`principal`] |
 //! | eq. 34–48 (47–48 \[CORRECTED\]), table 3 | Burgers creep in deviatoric tensor form, Crank–Nicolson, with a creep clock and creep steps relaxed to equilibrium | [`Burgers`], [`CreepClock`], [`creep_step`], [`burgers`] |
+//! | 7.2.8 | null model (excavation: no stiffness, mass, gravity or stress; nodes without a live element drop out), stage resets, geostatic initial stress (K0, depth gradient, principal values at an angle) | [`set_null`], [`reset_velocity`], [`reset_displacement`], [`reset_element_state`], [`InitialStress`] |
 //! | tables 4–7 | velocity/acceleration, force, face stress, move constraints | [`Boundary`] |
 //!
 //! The stable step of an element is `κ h / c_p` with h its smallest height, c_p the
@@ -132,7 +133,9 @@ pub mod mohr_coulomb;
 pub mod output;
 pub mod principal;
 
-pub use actions::{reset_displacement, reset_element_state, reset_velocity, set_velocity};
+pub use actions::{
+    reset_displacement, reset_element_state, reset_velocity, set_null, set_velocity,
+};
 pub use boundary::{Boundary, Components, Constraint, FaceStress, ACCEL_VELOCITY};
 pub use burgers::{creep_step, creep_time, Burgers, CreepClock, CREEP_CLOCK};
 pub use error::MechError;

@@ -108,6 +108,7 @@ struct Ids {
     strain: FieldId,
     extra: FieldId,
     state: FieldId,
+    null: FieldId,
 }
 
 /// Material assignments resolved on a mesh: the model index of every element and the
@@ -660,6 +661,7 @@ impl<D: Dim> Physics<D> for Mechanics {
             extra,
             names::MODEL_STATE.own_sized::<D>(n_state.max(1)),
             crate::actions::DISPLACEMENT_RESET.own::<D>(),
+            names::ELEMENT_NULL.own::<D>(),
         ];
         // Coupling inputs are read lagged: their owners (thermal, fluid) naturally come
         // after the mechanics in a composition, and a fluid physics that reads joint
@@ -712,11 +714,13 @@ impl<D: Dim> Physics<D> for Mechanics {
             names::ROTATION
         })?;
         let state = ctx.fields.id(names::MODEL_STATE)?;
+        let null = ctx.fields.id(names::ELEMENT_NULL)?;
         self.ids = Some(Ids {
             stress,
             strain,
             extra,
             state,
+            null,
         });
         if D::D == 3 {
             let rot = ctx.fields.get_mut(extra);
@@ -754,12 +758,17 @@ impl<D: Dim> Physics<D> for Mechanics {
     fn add_mass(
         &self,
         mesh: &Mesh<D>,
-        _fields: &FieldStore,
+        fields: &FieldStore,
         mass: &mut [f64],
         scale_to_dt: Option<f64>,
     ) {
         let npe = D::NODES_PER_ELEM;
+        let null = fields.id(names::ELEMENT_NULL).ok().map(|id| fields.get(id));
         for (e, conn) in mesh.elements().chunks_exact(npe).enumerate() {
+            // A null element has no mass (manual 7.2.8).
+            if null.is_some_and(|n| n[e] != 0.0) {
+                continue;
+            }
             let mut m = self.model_of(e).density() * self.geo.volume[e] / npe as f64;
             if let Some(dt) = scale_to_dt {
                 let dte = self.element_dt(e, false);
@@ -771,16 +780,21 @@ impl<D: Dim> Physics<D> for Mechanics {
         }
     }
 
-    fn stable_step(&self, kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
+    fn stable_step(&self, kin: &Kinematics<'_, D>, fields: &FieldStore) -> Option<StableStep> {
         let (mut best, mut which) = (f64::INFINITY, 0);
+        let null = fields.id(names::ELEMENT_NULL).ok().map(|id| fields.get(id));
         for e in 0..self.material.len() {
+            if null.is_some_and(|n| n[e] != 0.0) {
+                continue;
+            }
             let dt = self.element_dt(e, kin.damping);
             if dt < best {
                 best = dt;
                 which = e;
             }
         }
-        Some(StableStep {
+        // Every element null: the mechanics no longer limits the step.
+        best.is_finite().then(|| StableStep {
             dt: best,
             entity: Entity::new(EntityKind::Element, which),
             physics: "mechanics".into(),
@@ -805,9 +819,10 @@ impl<D: Dim> Physics<D> for Mechanics {
             self.gather_coupling::<D>(inp.conn, ctx.fields, &mut cvalues, ctx.backend);
         }
         let cref = &cvalues;
-        let [stress, strain, extra, state] = ctx
+        let [stress, strain, extra, state, null] = ctx
             .fields
-            .get_many_mut([ids.stress, ids.strain, ids.extra, ids.state]);
+            .get_many_mut([ids.stress, ids.strain, ids.extra, ids.state, ids.null]);
+        let null = &*null;
         let slots = &mut *ctx.slots;
         ctx.backend.install(|| {
             slots
@@ -828,6 +843,11 @@ impl<D: Dim> Physics<D> for Mechanics {
                         .zip(ms.chunks_exact_mut(ns));
                     for (i, ((((sl, st), ep), ex), ms)) in per_element.enumerate() {
                         let e = first + i;
+                        // A null element carries no force (manual 7.2.8).
+                        if null[e] != 0.0 {
+                            sl.fill(0.0);
+                            continue;
+                        }
                         let cv: &[f64] = if cstride == 0 {
                             &[]
                         } else {
@@ -988,6 +1008,11 @@ impl<D: Dim> Physics<D> for Mechanics {
                 "model_state",
                 setup.field(names::MODEL_STATE)?,
                 Access::ReadWrite,
+            )
+            .bind(
+                "element_null",
+                setup.field(names::ELEMENT_NULL)?,
+                Access::Read,
             )
             .bind("slots", setup.slots(), Access::ReadWrite);
         let kernel = if coupled {

@@ -466,7 +466,8 @@ fn no_coupling_declares_and_gathers_nothing() {
             "strain",
             "stress_zz",
             "model_state",
-            "displacement_reset"
+            "displacement_reset",
+            "element_null"
         ]
     );
     // A temperature owner alone does not make the mechanics read it.
@@ -483,7 +484,8 @@ fn no_coupling_declares_and_gathers_nothing() {
             "strain",
             "stress_zz",
             "model_state",
-            "displacement_reset"
+            "displacement_reset",
+            "element_null"
         ]
     );
     let plain = offline_kernel_sources::<_>(

@@ -685,12 +685,22 @@ mod tests {
 
     #[test]
     fn every_case_has_three_sizes() {
+        // Every variant of every case at three sizes.
         for case in CASES {
             let j = jobs(case, false);
-            let mut sizes: Vec<f64> = j.iter().map(|j| j.size).collect();
-            sizes.sort_by(f64::total_cmp);
-            sizes.dedup();
-            assert_eq!(sizes.len(), 3, "{case}");
+            let mut variants: Vec<&str> = j.iter().map(|j| j.variant).collect();
+            variants.sort_unstable();
+            variants.dedup();
+            for v in variants {
+                let mut sizes: Vec<f64> = j
+                    .iter()
+                    .filter(|j| j.variant == v)
+                    .map(|j| j.size)
+                    .collect();
+                sizes.sort_by(f64::total_cmp);
+                sizes.dedup();
+                assert_eq!(sizes.len(), 3, "{case} {v}");
+            }
         }
         assert!(jobs("kirsch", true)
             .iter()

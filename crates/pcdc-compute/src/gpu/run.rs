@@ -512,6 +512,8 @@ impl GpuRun {
         self.write_reals(builtin::DISPLACEMENT, &sim.state.u);
         self.write_reals(builtin::VELOCITY, &sim.state.v);
         self.write_reals(builtin::MASS, &sim.mass);
+        // Changes with the null model (Simulation::refresh_mass).
+        self.write_reals(builtin::MASS_PHYS, &sim.mass_phys);
         for (spec, &b) in sim.state.fields.specs().iter().zip(&self.field_buffers) {
             let id = sim.state.fields.id(&spec.name).expect("declared field");
             self.write_reals(b, sim.state.fields.get(id));

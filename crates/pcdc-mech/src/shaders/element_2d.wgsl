@@ -3,6 +3,14 @@
 // F = D_s D_m⁻¹, polar F = R U, ε = U − I in the co-rotated frame, σ from the model,
 // viscous stress D_f C sym(Rᵀ Ḟ) (eq. 17-19), f_a = −V₀ R σ ∇N_a into the slots.
 fn kernel(e: u32) {
+    // A null element carries no force (manual 7.2.8).
+    if element_null[e] != 0.0 {
+        let s0 = (SLOT_FIRST + 3u * e) * 2u;
+        for (var k = 0u; k < 6u; k = k + 1u) {
+            slots[s0 + k] = 0.0;
+        }
+        return;
+    }
     let n0 = conn[3u * e] * 2u;
     let n1 = conn[3u * e + 1u] * 2u;
     let n2 = conn[3u * e + 2u] * 2u;

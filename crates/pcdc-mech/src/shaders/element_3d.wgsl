@@ -59,6 +59,14 @@ fn polar_3d(f: M3, r_prev: M3) -> M3 {
 }
 
 fn kernel(e: u32) {
+    // A null element carries no force (manual 7.2.8).
+    if element_null[e] != 0.0 {
+        let s0 = (SLOT_FIRST + 4u * e) * 3u;
+        for (var k = 0u; k < 12u; k = k + 1u) {
+            slots[s0 + k] = 0.0;
+        }
+        return;
+    }
     var n: array<u32, 4>;
     for (var a = 0u; a < 4u; a = a + 1u) {
         n[a] = conn[4u * e + a] * 3u;
