@@ -6,16 +6,13 @@
 //! 4e-11 of the largest stress here in 3D), whichever is larger. Skips without a GPU adapter (fails with
 //! PCDC_REQUIRE_GPU=1).
 
+mod common;
+use common::{noise, rel_diff};
+
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{Backend, Precision, Simulation};
 use pcdc_mech::{Burgers, CreepClock, LinearElastic, Mechanics, CREEP_CLOCK};
 use pcdc_mesh::{builders, Dim, Mesh, Range};
-
-fn noise(i: usize) -> f64 {
-    let x = (i as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    let x = (x ^ (x >> 29)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    ((x >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-}
 
 /// The scene with Burgers or, with `elastic`, its instantaneous elastic part (the
 /// kinematics' own CPU–GPU difference in this scene).
@@ -65,16 +62,6 @@ fn scene<D: Dim>(mesh: Mesh<D>, backend: Backend, elastic: bool) -> [Vec<f64>; 3
         sim.field("stress").unwrap().to_vec(),
         sim.field("model_state").unwrap().to_vec(),
     ]
-}
-
-fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let diff = a
-        .iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-    diff / scale.max(f64::MIN_POSITIVE)
 }
 
 fn parity<D: Dim>(mesh: Mesh<D>, precision: Precision, tol: f64) {

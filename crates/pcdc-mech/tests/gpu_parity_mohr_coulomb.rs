@@ -5,17 +5,14 @@
 //! co-rotated frame) and has a softening material. Skips without a GPU adapter (fails
 //! with PCDC_REQUIRE_GPU=1).
 
+mod common;
+use common::{noise, rel_diff};
+
 use pcdc_compute::gpu::gpu_test_backend;
 use pcdc_compute::{Backend, Precision, Simulation, Table};
 use pcdc_mech::mohr_coulomb::{state, MC_STATE};
 use pcdc_mech::{LinearElastic, Mechanics, MohrCoulomb, Softening};
 use pcdc_mesh::{builders, Dim, Mesh, Range};
-
-fn noise(i: usize) -> f64 {
-    let x = (i as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    let x = (x ^ (x >> 29)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    ((x >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-}
 
 fn table(points: &[(f64, f64)]) -> Option<Table> {
     Some(Table::new("softening", points).unwrap())
@@ -74,20 +71,6 @@ fn scene<D: Dim>(mesh: Mesh<D>, backend: Backend, steps: u64) -> Out {
         u: sim.state.u.clone(),
         stress: sim.field("stress").unwrap().to_vec(),
         history: sim.field("model_state").unwrap().to_vec(),
-    }
-}
-
-fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let diff = a
-        .iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-    if scale == 0.0 {
-        diff
-    } else {
-        diff / scale
     }
 }
 

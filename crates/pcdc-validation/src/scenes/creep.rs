@@ -44,14 +44,7 @@ pub const TAU_CONVERGENCE: f64 = 1e3;
 /// Side of the block (m).
 pub const SIDE: f64 = 0.1;
 
-/// Plane strain or 3D.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Dimension {
-    /// Tri3, plane strain.
-    Two,
-    /// Tet4.
-    Three,
-}
+pub use super::Dimension;
 
 /// Scene parameters.
 #[derive(Clone, Debug)]

@@ -141,6 +141,51 @@ pub fn mesh(p: &Params) -> Result<Mesh<Dim2>, SceneError> {
     Ok(m)
 }
 
+/// The three single-dof supports of [`mesh`] (no reactions under a self-equilibrated
+/// load) added to `b`.
+pub fn supports(b: Boundary) -> Boundary {
+    b.constraint(
+        Range::group("support_east"),
+        Constraint::Line([1.0, 0.0, 0.0]),
+    )
+    .constraint(
+        Range::group("support_west"),
+        Constraint::Line([1.0, 0.0, 0.0]),
+    )
+    .constraint(
+        Range::group("support_north"),
+        Constraint::Line([0.0, 1.0, 0.0]),
+    )
+}
+
+/// The nodal-averaged stresses along θ = 0 for 1.1 a ≤ r ≤ 5 a, sorted by radius:
+/// (r / a, σθ, σr), compression positive (Pa), from the global element stress
+/// `stress` ([`output::global_stress`]). Errors when fewer than three nodes lie there.
+pub fn samples_on_axis(
+    sim: &Simulation<Dim2>,
+    stress: &[f64],
+    a: f64,
+) -> Result<Vec<(f64, f64, f64)>, SceneError> {
+    let nodal = output::nodal_average(sim.mesh(), stress, 3);
+    let mesh = sim.mesh();
+    let mut samples: Vec<(f64, f64, f64)> = (0..mesh.n_nodes())
+        .filter_map(|n| {
+            let x = mesh.node(n);
+            let r = x[0].hypot(x[1]);
+            (x[0] > 0.0 && x[1].abs() < 1e-9 * r && r >= 1.1 * a - 1e-12 && r <= 5.0 * a + 1e-12)
+                .then(|| (r / a, -nodal[3 * n + 1], -nodal[3 * n]))
+        })
+        .collect();
+    samples.sort_by(|x, y| x.0.total_cmp(&y.0));
+    if samples.len() < 3 {
+        return Err(SceneError::Measurement(format!(
+            "only {} nodes on θ = 0 between 1.1a and 5a",
+            samples.len()
+        )));
+    }
+    Ok(samples)
+}
+
 /// Runs the scene with one solver on `backend` (cloned into the simulation). The direct
 /// solve factorises on the host (faer) on every backend; dynamic relaxation steps on the
 /// backend.
@@ -151,29 +196,14 @@ pub fn run(backend: &Backend, p: &Params, solver: Solver) -> Result<Outcome, Sce
     let rock = LinearElastic::new(50e9, 0.25, 2500.0)?.with_damping(1.0)?;
     let mut sim = Simulation::builder(mesh, backend.clone())
         .physics(Mechanics::new().material(Range::All, rock))
-        .physics(
-            Boundary::new()
-                .face_stress(
-                    Range::group("outer"),
-                    FaceStress {
-                        xx: Some((-P1).into()),
-                        yy: Some((-P2).into()),
-                        ..Default::default()
-                    },
-                )
-                .constraint(
-                    Range::group("support_east"),
-                    Constraint::Line([1.0, 0.0, 0.0]),
-                )
-                .constraint(
-                    Range::group("support_west"),
-                    Constraint::Line([1.0, 0.0, 0.0]),
-                )
-                .constraint(
-                    Range::group("support_north"),
-                    Constraint::Line([0.0, 1.0, 0.0]),
-                ),
-        )
+        .physics(supports(Boundary::new().face_stress(
+            Range::group("outer"),
+            FaceStress {
+                xx: Some((-P1).into()),
+                yy: Some((-P2).into()),
+                ..Default::default()
+            },
+        )))
         .build()?;
     let report = match solver {
         Solver::Direct => sim.solve_linear(&StaticOptions {
@@ -200,23 +230,8 @@ pub fn run(backend: &Backend, p: &Params, solver: Solver) -> Result<Outcome, Sce
         let mut series = pcdc_mesh::vtu::PvdSeries::new(dir, &format!("kirsch_{}", solver.name()))?;
         output::write_step(&mut series, &sim)?;
     }
-    let nodal = output::nodal_average(sim.mesh(), &stress, 3);
+    let samples = samples_on_axis(&sim, &stress, a)?;
     let mesh = sim.mesh();
-    let mut samples: Vec<(f64, f64, f64)> = (0..mesh.n_nodes())
-        .filter_map(|n| {
-            let x = mesh.node(n);
-            let r = x[0].hypot(x[1]);
-            (x[0] > 0.0 && x[1].abs() < 1e-9 * r && r >= 1.1 * a - 1e-12 && r <= 5.0 * a + 1e-12)
-                .then(|| (r / a, -nodal[3 * n + 1], -nodal[3 * n]))
-        })
-        .collect();
-    samples.sort_by(|x, y| x.0.total_cmp(&y.0));
-    if samples.len() < 3 {
-        return Err(SceneError::Measurement(format!(
-            "only {} nodes on θ = 0 between 1.1a and 5a",
-            samples.len()
-        )));
-    }
     let scale = samples
         .iter()
         .map(|s| exact(s.0 * a, a).0.abs())

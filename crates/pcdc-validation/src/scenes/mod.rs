@@ -28,3 +28,13 @@ pub mod ucs;
 pub mod unconfined_flow;
 pub mod vibration_energy;
 pub mod wave_speed;
+
+/// Plane strain (Tri3) or 3D (Tet4), for the scenes that run both ([`triaxial`],
+/// [`creep`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dimension {
+    /// Plane strain, Tri3.
+    Two,
+    /// 3D, Tet4.
+    Three,
+}

@@ -39,6 +39,7 @@
 use std::time::Instant;
 
 use pcdc_compute::{Backend, Simulation, Table};
+use pcdc_mech::mohr_coulomb::state;
 use pcdc_mech::{output, Boundary, FaceStress, LinearElastic, Mechanics, MohrCoulomb};
 use pcdc_mesh::vtu::PvdSeries;
 use pcdc_mesh::{builders, Dim, Dim2, Dim3, Mesh, Range};
@@ -74,14 +75,7 @@ const STRAIN_MULTIPLE: f64 = 3.0;
 /// Samples per run.
 const SAMPLES: usize = 400;
 
-/// Which element family.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Dimension {
-    /// Plane strain, Tri3.
-    Two,
-    /// Tet4.
-    Three,
-}
+pub use super::Dimension;
 
 /// Scene parameters.
 #[derive(Clone, Debug)]
@@ -335,7 +329,10 @@ fn load<D: Dim>(
     let history = sim.field("model_state")?;
     let nstate = history.len() / ne;
     let yielded = (0..ne)
-        .filter(|&e| history[e * nstate + 1] > 0.0 || history[e * nstate + 3] > 0.0)
+        .filter(|&e| {
+            history[e * nstate + state::SHEAR_PAST] > 0.0
+                || history[e * nstate + state::TENSION_PAST] > 0.0
+        })
         .count();
     Ok((
         Curve {

@@ -25,7 +25,7 @@ use std::time::Instant;
 
 use pcdc_compute::{Backend, Simulation, StaticOptions, Table};
 use pcdc_mech::mohr_coulomb::{state, MC_STATE};
-use pcdc_mech::{output, Boundary, Constraint, FaceStress, LinearElastic, Mechanics, MohrCoulomb};
+use pcdc_mech::{output, Boundary, FaceStress, LinearElastic, Mechanics, MohrCoulomb};
 use pcdc_mesh::Range;
 
 use crate::report::SceneError;
@@ -144,7 +144,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
                 .material(Range::All, rock)
                 .initial_stress(Range::All, [-P0, -P0, -P0, 0.0, 0.0, 0.0]),
         )
-        .physics(
+        .physics(kirsch::supports(
             Boundary::new()
                 .face_stress(
                     Range::group("outer"),
@@ -159,20 +159,8 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
                         normal: Some(wall.into()),
                         ..Default::default()
                     },
-                )
-                .constraint(
-                    Range::group("support_east"),
-                    Constraint::Line([1.0, 0.0, 0.0]),
-                )
-                .constraint(
-                    Range::group("support_west"),
-                    Constraint::Line([1.0, 0.0, 0.0]),
-                )
-                .constraint(
-                    Range::group("support_north"),
-                    Constraint::Line([0.0, 1.0, 0.0]),
                 ),
-        )
+        ))
         .build()?;
     let opts = StaticOptions {
         tolerance: if backend.precision_kind() == pcdc_compute::Precision::F32 {
@@ -193,23 +181,8 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         let mut series = pcdc_mesh::vtu::PvdSeries::new(dir, "tunnel")?;
         output::write_step(&mut series, &sim)?;
     }
-    let nodal = output::nodal_average(sim.mesh(), &stress, 3);
+    let samples = kirsch::samples_on_axis(&sim, &stress, a)?;
     let mesh = sim.mesh();
-    let mut samples: Vec<(f64, f64, f64)> = (0..mesh.n_nodes())
-        .filter_map(|n| {
-            let x = mesh.node(n);
-            let r = x[0].hypot(x[1]);
-            (x[0] > 0.0 && x[1].abs() < 1e-9 * r && r >= 1.1 * a - 1e-12 && r <= 5.0 * a + 1e-12)
-                .then(|| (r / a, -nodal[3 * n + 1], -nodal[3 * n]))
-        })
-        .collect();
-    samples.sort_by(|x, y| x.0.total_cmp(&y.0));
-    if samples.len() < 3 {
-        return Err(SceneError::Measurement(format!(
-            "only {} nodes on θ = 0 between 1.1a and 5a",
-            samples.len()
-        )));
-    }
     let scale = samples.iter().map(|s| exact(s.0).0).fold(0.0, f64::max);
     let error = samples
         .iter()
