@@ -128,6 +128,7 @@ mod error;
 pub mod initial_stress;
 pub mod kinematics;
 mod mechanics;
+pub mod mixed;
 mod model;
 pub mod mohr_coulomb;
 pub mod output;

@@ -26,6 +26,7 @@ use rayon::prelude::*;
 
 use crate::initial_stress::InitialStress;
 use crate::kinematics::{dm_inv_2d, polar_2d_h, polar_3d};
+use crate::mixed::{trace_2d, MixedCells};
 use crate::model::{add_hooke, double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6};
 use crate::MechError;
 
@@ -82,6 +83,10 @@ pub struct Mechanics {
     geo: ElementGeometry,
     ids: Option<Ids>,
     coupling: CouplingInputs,
+    /// Cell data when the mesh has Quad4/Hex8 cells ([`crate::mixed`]).
+    mixed: Option<MixedCells>,
+    /// Per element: the trace of its co-rotated strain this step (mixed cells only).
+    trace: Vec<f64>,
 }
 
 /// A material assignment: the range, the model, and λ and 2μ (Pa) when the model is
@@ -426,6 +431,7 @@ impl Mechanics {
         state: &mut [f64],
         coupling: &[f64],
         visc: Option<f64>,
+        theta: Option<f64>,
         update: U,
     ) {
         let c = &inp.conn[3 * e..3 * e + 3];
@@ -448,7 +454,7 @@ impl Mechanics {
         // ε = U − I with U = Rᵀ(I + H), written without the cancellation of U − I:
         // U₀₀ − 1 = (cos θ − 1) + cos θ H₀₀ + sin θ H₁₀, U₁₁ − 1 = (cos θ − 1) + cos θ H₁₁ − sin θ H₀₁,
         // U₀₁ + U₁₀ = cos θ (H₀₁ + H₁₀) + sin θ (H₁₁ − H₀₀).
-        let eps: Sym6 = [
+        let mut eps: Sym6 = [
             cm1 + co * h[0] + si * h[2],
             cm1 + co * h[3] - si * h[1],
             0.0,
@@ -456,6 +462,12 @@ impl Mechanics {
             0.0,
             0.0,
         ];
+        // Mixed cell: the cell's mean volumetric strain replaces the element's.
+        if let Some(mean) = theta {
+            let corr = 0.5 * (mean - trace_2d(&h));
+            eps[0] += corr;
+            eps[1] += corr;
+        }
         let de: Sym6 = [
             eps[0] - strain[0],
             eps[1] - strain[1],
@@ -532,6 +544,7 @@ impl Mechanics {
         state: &mut [f64],
         coupling: &[f64],
         visc: Option<f64>,
+        theta: Option<f64>,
         update: U,
     ) {
         let c = &inp.conn[4 * e..4 * e + 4];
@@ -556,10 +569,15 @@ impl Mechanics {
         f[4] += 1.0;
         f[8] += 1.0;
         let r_prev: [f64; 9] = (&*rot).try_into().expect("9 values");
-        let r = polar_3d(&f, &r_prev);
+        // A mixed cell's elements found their rotation in the trace pass of this step.
+        let r = if theta.is_some() {
+            r_prev
+        } else {
+            polar_3d(&f, &r_prev)
+        };
         rot.copy_from_slice(&r);
         let u = crate::kinematics::mul3_tn(&r, &f);
-        let eps: Sym6 = [
+        let mut eps: Sym6 = [
             u[0] - 1.0,
             u[4] - 1.0,
             u[8] - 1.0,
@@ -567,6 +585,12 @@ impl Mechanics {
             0.5 * (u[5] + u[7]),
             0.5 * (u[2] + u[6]),
         ];
+        if let Some(mean) = theta {
+            let corr = (mean - (eps[0] + eps[1] + eps[2])) / 3.0;
+            eps[0] += corr;
+            eps[1] += corr;
+            eps[2] += corr;
+        }
         let mut de = [0.0; 6];
         for k in 0..6 {
             de[k] = eps[k] - strain[k];
@@ -616,6 +640,84 @@ impl Mechanics {
             }
         }
         slots[..3].copy_from_slice(&f0);
+    }
+}
+
+impl Mechanics {
+    /// The trace of every mixed-cell element's co-rotated strain (the first pass of the
+    /// mixed discretisation, [`crate::mixed`]); in 3D it also finds and stores the
+    /// element rotation, which the element pass then uses.
+    fn mixed_traces<D: Dim>(
+        &self,
+        mx: &MixedCells,
+        inp: &StepInputs<'_>,
+        extra: &mut [f64],
+        trace: &mut [f64],
+        backend: &Backend,
+    ) {
+        let d = D::D;
+        backend.install(|| {
+            if d == 2 {
+                trace.par_iter_mut().enumerate().for_each(|(e, t)| {
+                    if mx.is_mixed(e) {
+                        *t = trace_2d(&self.displacement_gradient_2d(e, inp));
+                    }
+                });
+            } else {
+                trace
+                    .par_iter_mut()
+                    .zip(extra.par_chunks_mut(9))
+                    .enumerate()
+                    .for_each(|(e, (t, rot))| {
+                        if mx.is_mixed(e) {
+                            let f = self.deformation_gradient_3d(e, inp);
+                            let r_prev: [f64; 9] = (&*rot).try_into().expect("9 values");
+                            let r = polar_3d(&f, &r_prev);
+                            rot.copy_from_slice(&r);
+                            let u = crate::kinematics::mul3_tn(&r, &f);
+                            *t = (u[0] - 1.0) + (u[4] - 1.0) + (u[8] - 1.0);
+                        }
+                    });
+            }
+        });
+    }
+
+    /// Displacement gradient H = [u₁ − u₀, u₂ − u₀] D_m⁻¹ of triangle `e` (row-major).
+    #[inline]
+    fn displacement_gradient_2d(&self, e: usize, inp: &StepInputs<'_>) -> [f64; 4] {
+        let c = &inp.conn[3 * e..3 * e + 3];
+        let (n0, n1, n2) = (c[0] as usize * 2, c[1] as usize * 2, c[2] as usize * 2);
+        let m = &self.geo.dm_inv[4 * e..4 * e + 4];
+        let u = inp.u;
+        let (d0, d1) = (u[n1] - u[n0], u[n2] - u[n0]);
+        let (d2, d3) = (u[n1 + 1] - u[n0 + 1], u[n2 + 1] - u[n0 + 1]);
+        [
+            d0 * m[0] + d1 * m[2],
+            d0 * m[1] + d1 * m[3],
+            d2 * m[0] + d3 * m[2],
+            d2 * m[1] + d3 * m[3],
+        ]
+    }
+
+    /// Deformation gradient F = I + [u_j − u₀] D_m⁻¹ of tetrahedron `e` (row-major).
+    #[inline]
+    fn deformation_gradient_3d(&self, e: usize, inp: &StepInputs<'_>) -> [f64; 9] {
+        let c = &inp.conn[4 * e..4 * e + 4];
+        let mut du = [0.0; 9];
+        let o = c[0] as usize * 3;
+        for i in 0..3 {
+            for j in 0..3 {
+                du[3 * i + j] = inp.u[c[j + 1] as usize * 3 + i] - inp.u[o + i];
+            }
+        }
+        let mm: [f64; 9] = self.geo.dm_inv[9 * e..9 * e + 9]
+            .try_into()
+            .expect("9 values");
+        let mut f = crate::kinematics::mul3(&du, &mm);
+        f[0] += 1.0;
+        f[4] += 1.0;
+        f[8] += 1.0;
+        f
     }
 }
 
@@ -700,6 +802,12 @@ impl<D: Dim> Physics<D> for Mechanics {
         self.material = material;
         self.n_state = self.models.iter().map(|m| m.n_state()).max().unwrap_or(0);
         self.geo = geometry(mesh);
+        self.mixed = MixedCells::of(mesh, &self.geo.volume);
+        self.trace = if self.mixed.is_some() {
+            vec![0.0; ne]
+        } else {
+            Vec::new()
+        };
         let models: Vec<(&str, &[FieldKey])> = self
             .models
             .iter()
@@ -823,6 +931,12 @@ impl<D: Dim> Physics<D> for Mechanics {
             .fields
             .get_many_mut([ids.stress, ids.strain, ids.extra, ids.state, ids.null]);
         let null = &*null;
+        if let Some(mx) = &self.mixed {
+            let mut trace = std::mem::take(&mut self.trace);
+            self.mixed_traces::<D>(mx, &inp, extra, &mut trace, ctx.backend);
+            self.trace = trace;
+        }
+        let trace = &self.trace;
         let slots = &mut *ctx.slots;
         ctx.backend.install(|| {
             slots
@@ -859,15 +973,23 @@ impl<D: Dim> Physics<D> for Mechanics {
                         let visc =
                             (inp.damping && k.damp2 > 0.0).then(|| self.viscous_coefficient(e));
                         let model = &*self.models[mi];
+                        let theta = self
+                            .mixed
+                            .as_ref()
+                            .filter(|mx| mx.is_mixed(e))
+                            .map(|mx| mx.mean(e, trace));
                         // The built-in elastic law inline, any other through its trait.
                         macro_rules! element {
                             ($update:expr) => {
                                 if d == 2 {
                                     self.element_2d(
-                                        e, &inp, sl, st, ep, &mut ex[0], ms, cv, visc, $update,
+                                        e, &inp, sl, st, ep, &mut ex[0], ms, cv, visc, theta,
+                                        $update,
                                     );
                                 } else {
-                                    self.element_3d(e, &inp, sl, st, ep, ex, ms, cv, visc, $update);
+                                    self.element_3d(
+                                        e, &inp, sl, st, ep, ex, ms, cv, visc, theta, $update,
+                                    );
                                 }
                             };
                         }
@@ -1031,14 +1153,29 @@ impl<D: Dim> Physics<D> for Mechanics {
         trip: &mut Vec<(usize, usize, f64)>,
     ) -> Result<bool, ComputeError> {
         let (d, npe) = (D::D, D::NODES_PER_ELEM);
+        let mut tangents = Vec::with_capacity(mesh.n_elements());
         for e in 0..mesh.n_elements() {
             let model = self.model_of(e);
-            let t = model.linear_tangent().ok_or_else(|| {
+            tangents.push(model.linear_tangent().ok_or_else(|| {
                 ComputeError::NotLinear(format!(
                     "model '{}' of element {e} is not linear",
                     model.name()
                 ))
-            })?;
+            })?);
+        }
+        let grad_of = |e: usize| {
+            let m = &self.geo.dm_inv[e * d * d..(e + 1) * d * d];
+            let mut grad = [[0.0; 3]; 4];
+            for a in 1..npe {
+                for k in 0..d {
+                    grad[a][k] = m[(a - 1) * d + k];
+                    grad[0][k] -= m[(a - 1) * d + k];
+                }
+            }
+            grad
+        };
+        for e in 0..mesh.n_elements() {
+            let t = tangents[e];
             // C_ijkl from the 6x6 tangent on tensor components.
             let voigt = |i: usize, j: usize| -> usize {
                 match (i.min(j), i.max(j)) {
@@ -1054,14 +1191,26 @@ impl<D: Dim> Physics<D> for Mechanics {
                 let b = voigt(k, l);
                 t[voigt(i, j)][b] / if b >= 3 { 2.0 } else { 1.0 }
             };
-            let m = &self.geo.dm_inv[e * d * d..(e + 1) * d * d];
-            let mut grad = [[0.0; 3]; 4];
-            for a in 1..npe {
-                for k in 0..d {
-                    grad[a][k] = m[(a - 1) * d + k];
-                    grad[0][k] -= m[(a - 1) * d + k];
+            if let Some(mx) = self.mixed.as_ref().filter(|mx| mx.is_mixed(e)) {
+                // The B̄ stiffness of the whole cell, once, at its first element.
+                if mx.first[e] as usize == e {
+                    let c = |el: usize, i: usize, j: usize, k: usize, l: usize| {
+                        let b = voigt(k, l);
+                        tangents[el][voigt(i, j)][b] / if b >= 3 { 2.0 } else { 1.0 }
+                    };
+                    crate::mixed::cell_stiffness(
+                        d,
+                        e..e + mx.count[e] as usize,
+                        &self.geo.volume,
+                        &grad_of,
+                        &|el| mesh.element(el).to_vec(),
+                        &c,
+                        trip,
+                    );
                 }
+                continue;
             }
+            let grad = grad_of(e);
             let vol = self.geo.volume[e];
             let conn = mesh.element(e);
             for a in 0..npe {

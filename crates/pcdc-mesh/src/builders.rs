@@ -26,6 +26,9 @@ const MAX_ELEMENTS: f64 = u32::MAX as f64;
 /// A named boundary: its nodes, from which its boundary faces are found.
 type Boundary = (&'static str, Vec<u32>);
 
+mod quad_hex;
+pub use quad_hex::{cuboid_hexes, rectangle_quads, ring_mixed, ring_quads};
+
 // ---------------------------------------------------------------------------------------
 // Parameter checks
 // ---------------------------------------------------------------------------------------
@@ -93,7 +96,14 @@ fn finish<D: Dim>(
     elements: Vec<u32>,
     boundaries: Vec<Boundary>,
 ) -> Result<Mesh<D>, MeshError> {
-    let mut mesh = Mesh::<D>::new(coords, elements)?;
+    add_boundaries(Mesh::<D>::new(coords, elements)?, boundaries)
+}
+
+/// Adds the boundary node and face groups and the element group `"all"`.
+fn add_boundaries<D: Dim>(
+    mut mesh: Mesh<D>,
+    boundaries: Vec<Boundary>,
+) -> Result<Mesh<D>, MeshError> {
     for (name, nodes) in boundaries {
         let mut on = vec![false; mesh.n_nodes()];
         nodes.iter().for_each(|&n| on[n as usize] = true);

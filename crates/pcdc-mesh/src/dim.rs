@@ -5,22 +5,56 @@
 
 use std::fmt::Debug;
 
-/// The element type of a block (manual chapter 4, item 2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// The element type of a cell (manual chapter 4, item 2).
+///
+/// The computational elements of a [`crate::Mesh`] are simplices (Tri3 in 2D, Tet4 in
+/// 3D); a Quad4 or Hex8 cell is stored as the simplices it is cut into (see
+/// [`crate::cells`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum ElementKind {
     /// Three-node triangle, nodes counter-clockwise.
     Tri3,
     /// Four-node tetrahedron, positive volume (nodes 1, 2, 3 counter-clockwise seen from node 4).
     Tet4,
+    /// Four-node quadrilateral, nodes counter-clockwise (Gmsh type 3).
+    Quad4,
+    /// Eight-node hexahedron in Gmsh/VTK order: nodes 0-3 the bottom face counter-clockwise
+    /// seen from the top, nodes 4-7 above them (Gmsh type 5).
+    Hex8,
 }
 
 impl ElementKind {
-    /// VTK cell type id (5 = VTK_TRIANGLE, 10 = VTK_TETRA).
+    /// VTK cell type id (5 = VTK_TRIANGLE, 10 = VTK_TETRA, 9 = VTK_QUAD,
+    /// 12 = VTK_HEXAHEDRON).
     pub fn vtk_cell_type(self) -> u8 {
         match self {
             ElementKind::Tri3 => 5,
             ElementKind::Tet4 => 10,
+            ElementKind::Quad4 => 9,
+            ElementKind::Hex8 => 12,
         }
+    }
+
+    /// Number of nodes (3, 4, 4, 8).
+    pub fn n_nodes(self) -> usize {
+        match self {
+            ElementKind::Tri3 => 3,
+            ElementKind::Tet4 | ElementKind::Quad4 => 4,
+            ElementKind::Hex8 => 8,
+        }
+    }
+
+    /// Space dimension of the cell (2 or 3).
+    pub fn dim(self) -> usize {
+        match self {
+            ElementKind::Tri3 | ElementKind::Quad4 => 2,
+            ElementKind::Tet4 | ElementKind::Hex8 => 3,
+        }
+    }
+
+    /// Whether the cell is a simplex (one computational element).
+    pub fn is_simplex(self) -> bool {
+        matches!(self, ElementKind::Tri3 | ElementKind::Tet4)
     }
 }
 

@@ -43,6 +43,15 @@ pub enum MeshError {
         threshold: f64,
         measure_name: &'static str,
     },
+    /// A Quad4/Hex8 (or simplex) cell given to [`crate::Mesh::from_cells`] is invalid:
+    /// wrong dimension, bad or repeated node, degenerate, inverted, twisted or
+    /// non-convex.
+    #[error("cell {cell} ({kind:?}) {reason}")]
+    BadCell {
+        cell: usize,
+        kind: crate::ElementKind,
+        reason: String,
+    },
     /// A node is referenced by no element.
     #[error("node {node} is dangling: no element uses it")]
     DanglingNode { node: usize },

@@ -7,11 +7,13 @@
 //!   files are rejected with a [`MeshError::Parse`] that says so.
 //! * **Sections.** `$MeshFormat`, `$PhysicalNames`, `$Entities`, `$Nodes` and `$Elements`
 //!   are read; any other section (`$Periodic`, `$NodeData`, `$Comments`, ...) is skipped.
-//! * **Elements.** The linear simplices of the top dimension (Gmsh type 2, 3-node
-//!   triangles, for [`Dim2`](crate::Dim2); type 4, 4-node tetrahedra, for
-//!   [`Dim3`](crate::Dim3)) become the mesh elements, reoriented where needed. Any other
-//!   element type of the top dimension (quadrangles, hexahedra, second-order elements, ...)
-//!   is an error naming the type and line. Elements of a dimension above the mesh
+//! * **Elements.** The linear elements of the top dimension (Gmsh type 2, 3-node
+//!   triangles, and type 3, 4-node quadrangles, for [`Dim2`](crate::Dim2); type 4, 4-node
+//!   tetrahedra, and type 5, 8-node hexahedra, for [`Dim3`](crate::Dim3)), mixed freely,
+//!   become the mesh cells, reoriented where needed; quadrangles and hexahedra are cut
+//!   into simplices as [`crate::cells`] describes, and a twisted or degenerate one is an
+//!   error naming its tag and line. Any other element type of the top dimension (prisms,
+//!   pyramids, second-order elements, ...) is an error naming the type and line. Elements of a dimension above the mesh
 //!   dimension are an error as well (a 3D file read as 2D).
 //! * **Nodes.** Node tags may be sparse and in any order. Nodes used by no top-dimension
 //!   element are dropped; the remaining nodes are numbered 0, 1, ... in increasing tag
@@ -21,8 +23,9 @@
 //! * **Groups.** Every physical group becomes groups named after its physical name, or
 //!   `physical_<tag>` when it has none:
 //!   - a physical group of the top dimension gives an element group and a node group;
-//!   - a physical group of dimension `D - 1` (lines in 2D, triangles in 3D) gives a face
-//!     group (each line/triangle is matched with the mesh face with the same nodes; an
+//!   - a physical group of dimension `D - 1` (lines in 2D, triangles or quadrangles in 3D)
+//!     gives a face group (each line/triangle is matched with the mesh face with the same
+//!     nodes, a quadrangle with the two triangles a hexahedron's face is cut into; an
 //!     element that is no face of the mesh is an error naming its line) and a node group;
 //!   - lower-dimensional physical groups (points, and curves in 3D) give node groups.
 //!
@@ -55,7 +58,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 use std::str::FromStr;
 
-use crate::{Dim, Mesh, MeshError};
+use crate::{Dim, ElementKind, Mesh, MeshError};
 
 mod coincident;
 pub use coincident::{ImportOptions, ImportWarning, COINCIDENT_REL_TOL};
@@ -243,6 +246,26 @@ fn simplex_type(dim: usize) -> i32 {
         1 => 1,
         2 => 2,
         _ => 4,
+    }
+}
+
+/// The non-simplex linear cell read in dimension `dim`: quadrangles (type 3) in 2D,
+/// hexahedra (type 5) in 3D.
+fn cell_type(dim: usize) -> i32 {
+    if dim == 2 {
+        3
+    } else {
+        5
+    }
+}
+
+/// The cell kind of a top-dimension Gmsh element type.
+fn kind_of(etype: i32) -> ElementKind {
+    match etype {
+        2 => ElementKind::Tri3,
+        3 => ElementKind::Quad4,
+        5 => ElementKind::Hex8,
+        _ => ElementKind::Tet4,
     }
 }
 
@@ -776,19 +799,24 @@ fn parse_elements(
                 type_name(etype)
             )));
         }
-        if edim == d && etype != top {
+        if edim == d && etype != top && etype != cell_type(d) {
             return Err(b.err(format!(
-                "element {} is not supported: a {d}D mesh must consist of linear {} (type {top}) only; \
-                 remesh with first-order simplices (Mesh.ElementOrder = 1, no recombination)",
+                "element {} is not supported: a {d}D mesh must consist of linear {} (type {top}) \
+                 or {} (type {}) only; remesh with first-order elements (Mesh.ElementOrder = 1)",
                 type_name(etype),
-                simplex_plural(d)
+                simplex_plural(d),
+                if d == 2 { "quadrangles" } else { "hexahedra" },
+                cell_type(d)
             )));
         }
         b.finish("the number of elements in the block")?;
         total = total
             .checked_add(n)
             .ok_or_else(|| parse_error(r.file, line, "the element count overflows"))?;
-        let kept = etype == simplex_type(edim);
+        // Top-dimension quadrangles/hexahedra, and quadrangle faces of a 3D mesh.
+        let kept = etype == simplex_type(edim)
+            || (edim == d && etype == cell_type(d))
+            || (d == 3 && edim == 2 && etype == 3);
         let npe = if kept {
             type_info(etype).map_or(0, |t| t.1)
         } else {
@@ -866,7 +894,7 @@ fn build_mesh<D: Dim>(
     file: &str,
     options: &ImportOptions,
 ) -> Result<MshImport<D>, MeshError> {
-    let (d, npe) = (D::D, D::NODES_PER_ELEM);
+    let d = D::D;
     let err = |line: usize, message: String| parse_error(file, line, message);
     let Some(elements_line) = raw.elements_line else {
         return Err(err(raw.last_line, "missing $Elements section".into()));
@@ -891,8 +919,10 @@ fn build_mesh<D: Dim>(
     let mut conn_sorted = Vec::new();
     let mut elem_lines = Vec::new();
     let mut elem_tags = Vec::new();
+    let mut kinds = Vec::new();
     for b in raw.blocks.iter().filter(|b| b.kept && b.dim == d) {
-        for (k, tags) in b.nodes.chunks_exact(npe).enumerate() {
+        for (k, tags) in b.nodes.chunks_exact(b.npe).enumerate() {
+            kinds.push(kind_of(b.etype));
             for &t in tags {
                 let i = find(t).ok_or_else(|| {
                     err(
@@ -1006,8 +1036,13 @@ fn build_mesh<D: Dim>(
     }
     let conn: Vec<u32> = conn_sorted.iter().map(|&i| new_index[i]).collect();
     let last_line = raw.last_line;
-    let mut mesh = Mesh::<D>::new_reoriented(coords, conn)
-        .map_err(|e| mesh_error(e, file, last_line, &elem_lines, &elem_tags, &node_tags))?;
+    let built = if kinds.iter().all(|k| k.is_simplex()) {
+        Mesh::<D>::new_reoriented(coords, conn)
+    } else {
+        Mesh::<D>::from_cells_reoriented(coords, kinds, conn)
+    };
+    let mut mesh =
+        built.map_err(|e| mesh_error(e, file, last_line, &elem_lines, &elem_tags, &node_tags))?;
 
     // Physical groups.
     let name_of = |dim: usize, tag: i32| {
@@ -1049,24 +1084,23 @@ fn build_mesh<D: Dim>(
         }
     }
 
-    let mut first_elem = 0u32;
+    let mut first_cell = 0usize;
     for b in &raw.blocks {
         let phys = phys_of(b);
         if b.dim == d {
-            let n = b.tags.len() as u32;
+            let cells = first_cell..first_cell + b.tags.len();
             for &p in phys {
                 let name = name_of(b.dim, p);
-                let range = first_elem as usize..(first_elem + n) as usize;
-                elem_groups
-                    .entry(name.clone())
-                    .or_default()
-                    .extend(first_elem..first_elem + n);
-                node_groups
-                    .entry(name)
-                    .or_default()
-                    .extend(&mesh.elements()[range.start * npe..range.end * npe]);
+                let elems = elem_groups.entry(name.clone()).or_default();
+                for c in cells.clone() {
+                    elems.extend(mesh.cell_elements(c).map(|e| e as u32));
+                }
+                let nodes = node_groups.entry(name).or_default();
+                for c in cells.clone() {
+                    nodes.extend_from_slice(mesh.cell_nodes(c));
+                }
             }
-            first_elem += n;
+            first_cell = cells.end;
             continue;
         }
         let Some(&p0) = phys.first() else { continue };
@@ -1084,7 +1118,7 @@ fn build_mesh<D: Dim>(
         let is_face = b.dim + 1 == d;
         for (k, tags) in b.nodes.chunks_exact(b.npe.max(1)).enumerate() {
             let (line, etag) = (b.lines[k], b.tags[k]);
-            let mut key = [u32::MAX; 3];
+            let mut key = [u32::MAX; 4];
             for (j, &t) in tags.iter().enumerate() {
                 let i = find(t).ok_or_else(|| {
                     err(
@@ -1104,9 +1138,34 @@ fn build_mesh<D: Dim>(
                 }
                 key[j] = new_index[i];
             }
-            let face = if is_face {
-                key[..tags.len()].sort_unstable();
-                let f = face_map.get(&key).copied().ok_or_else(|| {
+            let faces = if is_face && tags.len() == 4 {
+                // A hexahedron face: the two triangles of either diagonal.
+                let q = key;
+                let tri = |a: u32, b: u32, c: u32| {
+                    let mut k = [a, b, c];
+                    k.sort_unstable();
+                    face_map.get(&k).copied()
+                };
+                let pair = match (tri(q[0], q[1], q[2]), tri(q[0], q[2], q[3])) {
+                    (Some(f), Some(g)) => Some([f, g]),
+                    _ => tri(q[0], q[1], q[3])
+                        .zip(tri(q[1], q[2], q[3]))
+                        .map(|(f, g)| [f, g]),
+                };
+                let pair = pair.ok_or_else(|| {
+                    err(
+                        line,
+                        format!(
+                            "element {etag} (physical group '{}', nodes {tags:?}) is not a face of any hexahedron of the mesh",
+                            name_of(b.dim, p0)
+                        ),
+                    )
+                })?;
+                pair.to_vec()
+            } else if is_face {
+                let mut k3 = [key[0], key[1], key[2]];
+                k3[..tags.len()].sort_unstable();
+                let f = face_map.get(&k3).copied().ok_or_else(|| {
                     err(
                         line,
                         format!(
@@ -1116,15 +1175,16 @@ fn build_mesh<D: Dim>(
                         ),
                     )
                 })?;
-                Some(f)
+                vec![f]
             } else {
-                None
+                Vec::new()
             };
             for &p in phys {
                 let name = name_of(b.dim, p);
-                if let Some(f) = face {
-                    face_groups.entry(name.clone()).or_default().push(f);
-                }
+                face_groups
+                    .entry(name.clone())
+                    .or_default()
+                    .extend_from_slice(&faces);
                 node_groups
                     .entry(name)
                     .or_default()
@@ -1187,6 +1247,10 @@ fn mesh_error(
                 tag_of(*element),
                 nodes.iter().map(|&n| node_tag(n)).collect::<Vec<_>>()
             ),
+        ),
+        MeshError::BadCell { cell, kind, reason } => (
+            line_of(*cell),
+            format!("element {} ({kind:?}) {reason}", tag_of(*cell)),
         ),
         MeshError::InvertedElement { element, .. } | MeshError::BadNodeIndex { element, .. } => {
             (line_of(*element), format!("element {}: {e}", tag_of(*element)))
@@ -1391,15 +1455,100 @@ mod tests {
         assert!(msg.contains("empty"), "{msg}");
     }
 
+    /// Two hexahedra side by side (the second listed inverted) with a physical volume
+    /// and a physical quadrangle face.
+    fn two_hexes() -> String {
+        let tag = |i: usize, j: usize, k: usize| 1 + i + 3 * (j + 2 * k);
+        let mut t = String::from(
+            "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n2 1 \"xmin\"\n3 2 \"rock\"\n$EndPhysicalNames\n\
+             $Entities\n0 0 1 1\n1 0 0 0 0 1 1 1 1 0\n1 0 0 0 2 1 1 1 2 0\n$EndEntities\n\
+             $Nodes\n1 12 1 12\n3 1 0 12\n",
+        );
+        for n in 1..=12 {
+            t += &format!("{n}\n");
+        }
+        for k in 0..2 {
+            for j in 0..2 {
+                for i in 0..3 {
+                    t += &format!("{i} {j} {k}\n");
+                }
+            }
+        }
+        t += "$EndNodes\n$Elements\n2 3 1 3\n2 1 3 1\n";
+        t += &format!(
+            "1 {} {} {} {}\n",
+            tag(0, 0, 0),
+            tag(0, 1, 0),
+            tag(0, 1, 1),
+            tag(0, 0, 1)
+        );
+        t += "3 1 5 2\n";
+        let hex = |i: usize| {
+            [
+                tag(i, 0, 0),
+                tag(i + 1, 0, 0),
+                tag(i + 1, 1, 0),
+                tag(i, 1, 0),
+                tag(i, 0, 1),
+                tag(i + 1, 0, 1),
+                tag(i + 1, 1, 1),
+                tag(i, 1, 1),
+            ]
+        };
+        let mut h1 = hex(1);
+        h1.swap(1, 3);
+        h1.swap(5, 7);
+        for (e, h) in [(2, hex(0)), (3, h1)] {
+            t += &format!("{e} {}\n", h.map(|v| v.to_string()).join(" "));
+        }
+        t + "$EndElements\n"
+    }
+
+    #[test]
+    fn hexahedra_and_their_quadrangle_faces_are_read() {
+        let m = parse_msh::<Dim3>(&two_hexes(), "hex.msh").unwrap();
+        assert_eq!(m.n_cells(), 2);
+        assert!((0..2).all(|c| m.cell_kind(c) == ElementKind::Hex8));
+        let vol: f64 = (0..m.n_elements()).map(|e| m.element_measure(e)).sum();
+        assert!((vol - 2.0).abs() < 1e-12, "{vol}");
+        assert_eq!(m.groups().elements["rock"].len(), m.n_elements());
+        let xmin = &m.groups().faces["xmin"];
+        assert_eq!(xmin.len(), 2);
+        let mut c = [0.0; 3];
+        for &f in xmin {
+            m.face_centroid(f as usize, &mut c);
+            assert!(c[0].abs() < 1e-12 && m.faces().neighbor[f as usize] == crate::NO_NEIGHBOR);
+        }
+        // A hexahedron with a node moved through its opposite face is twisted.
+        let bad = two_hexes().replacen("1 0 1\n", "1 0 -2\n", 1);
+        let (_, msg) = parse_err::<Dim3>(&bad);
+        assert!(msg.contains("Hex8") && msg.contains("element 2"), "{msg}");
+    }
+
+    #[test]
+    fn mixed_triangles_and_quadrangles_are_read() {
+        let t = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 1 0\n1 0 0 0 2 1 0 0 0\n$EndEntities\n\
+                 $Nodes\n1 6 1 6\n2 1 0 6\n1\n2\n3\n4\n5\n6\n0 0 0\n1 0 0\n2 0 0\n0 1 0\n1 1 0\n2 1 0\n$EndNodes\n\
+                 $Elements\n2 3 1 3\n2 1 3 1\n1 1 2 5 4\n2 1 2 2\n2 2 3 6\n3 2 6 5\n$EndElements\n";
+        let m = parse_msh::<Dim2>(t, "mixed.msh").unwrap();
+        let kinds: Vec<ElementKind> = (0..m.n_cells()).map(|c| m.cell_kind(c)).collect();
+        assert_eq!(
+            kinds,
+            [ElementKind::Quad4, ElementKind::Tri3, ElementKind::Tri3]
+        );
+        assert_eq!(m.n_elements(), 4);
+    }
+
     #[test]
     fn unsupported_top_dimension_types_name_type_and_line() {
         let t = square_text();
-        // The triangle block declared as quadrangles.
+        // The triangle block declared as quadrangles (which are read): its first
+        // element has too few nodes.
         let quad = t.replacen("2 1 2 4\n", "2 1 3 4\n", 1);
         let (line, msg) = parse_err::<Dim2>(&quad);
-        assert_eq!(line, line_of(&t, "2 1 2 4"));
+        assert_eq!(line, line_of(&t, "2 1 2 4") + 1);
         assert!(
-            msg.contains("type 3") && msg.contains("quadrangle"),
+            msg.contains("too few node tags") && msg.contains("quadrangle"),
             "{msg}"
         );
         let second = t.replacen("2 1 2 4\n", "2 1 9 4\n", 1);

@@ -279,12 +279,13 @@ fn face_key(nodes: impl Iterator<Item = u32>) -> [u32; 3] {
 }
 
 /// Splits the nodes of the elements in `fdem` (selected by centroid) and puts an
-/// interface on every interior face with at least one FDEM element on either side;
+/// interface on every interior face with at least one FDEM element on either side
+/// (never inside a Quad4/Hex8 cell, whose simplices keep sharing its nodes);
 /// returns the split mesh, which carries the interfaces and the master-node map
 /// ([`crate::Mesh::interfaces`]).
 ///
-/// Elements keep their index and node order; an FDEM element's nodes are numbered
-/// consecutively in element order, a node of pure-FEM elements once, where first met.
+/// Elements keep their index and node order; an FDEM cell's nodes are numbered
+/// consecutively in cell order, a node of pure-FEM elements once, where first met.
 /// Groups carry over: node groups to every copy, element groups unchanged, face groups
 /// to the corresponding faces of the split mesh (both sides for interior faces).
 /// Interfaces follow the faces of the original mesh in order; side A is the face's
@@ -308,9 +309,15 @@ pub fn split_nodes<D: Dim>(mesh: &Mesh<D>, fdem: &Range) -> Result<Mesh<D>, Mesh
     let mut master: Vec<u32> = Vec::with_capacity(ne * npe);
     let mut shared = vec![u32::MAX; mesh.n_nodes()];
     let mut conn = Vec::with_capacity(ne * npe);
-    for e in 0..ne {
-        for &n in mesh.element(e) {
-            let new = if is_fdem[e] {
+    // A Quad4/Hex8 cell is split as one piece: its simplices keep sharing its nodes.
+    let mut cell_nodes = Vec::with_capacity(mesh.cells().all_nodes().len());
+    let mut local: Vec<(u32, u32)> = Vec::with_capacity(8);
+    for c in 0..mesh.n_cells() {
+        let els = mesh.cell_elements(c);
+        let fdem_cell = is_fdem[els.start];
+        local.clear();
+        for &n in mesh.cell_nodes(c) {
+            let new = if fdem_cell {
                 master.push(n);
                 master.len() as u32 - 1
             } else {
@@ -320,7 +327,14 @@ pub fn split_nodes<D: Dim>(mesh: &Mesh<D>, fdem: &Range) -> Result<Mesh<D>, Mesh
                 }
                 shared[n as usize]
             };
-            conn.push(new);
+            local.push((n, new));
+            cell_nodes.push(new);
+        }
+        for e in els {
+            for &n in mesh.element(e) {
+                let new = local.iter().find(|p| p.0 == n).expect("a cell node").1;
+                conn.push(new);
+            }
         }
     }
     let mut coords = Vec::with_capacity(master.len() * d);
@@ -328,6 +342,9 @@ pub fn split_nodes<D: Dim>(mesh: &Mesh<D>, fdem: &Range) -> Result<Mesh<D>, Mesh
         coords.extend_from_slice(mesh.node(m as usize));
     }
     let mut split = Mesh::<D>::new(coords, conn)?;
+    if !mesh.cells().is_empty() {
+        split.set_cells(mesh.cells().with_nodes(cell_nodes));
+    }
     // Faces of the split mesh by their node set.
     let new_faces: HashMap<[u32; 3], u32> = (0..split.faces().len())
         .map(|f| (face_key(split.face(f).iter().copied()), f as u32))
@@ -375,7 +392,7 @@ pub fn split_nodes<D: Dim>(mesh: &Mesh<D>, fdem: &Range) -> Result<Mesh<D>, Mesh
         if fb != fa {
             face_map[f].push(fb);
         }
-        if is_fdem[a] || is_fdem[b] {
+        if (is_fdem[a] || is_fdem[b]) && mesh.cell_of(a) != mesh.cell_of(b) {
             joints.nodes.extend(orig.iter().map(|&n| copy_of(a, n)));
             joints.nodes.extend(orig.iter().map(|&n| copy_of(b, n)));
             joints.elements.extend_from_slice(&[a as u32, b as u32]);

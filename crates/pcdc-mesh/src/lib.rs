@@ -34,12 +34,14 @@
 // Index loops mirror the tensor notation of the manual's equations.
 #![allow(clippy::needless_range_loop)]
 
+pub mod cells;
 mod dim;
 mod error;
 mod interface;
 mod mesh;
 mod range;
 
+pub use cells::Cells;
 pub use dim::{Dim, Dim2, Dim3, ElementKind};
 pub use error::MeshError;
 pub use interface::{split_nodes, Interface, Interfaces};

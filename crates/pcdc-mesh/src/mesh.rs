@@ -3,7 +3,7 @@
 use std::collections::{BTreeMap, HashMap};
 use std::marker::PhantomData;
 
-use crate::{Dim, Interfaces, MeshError, Range};
+use crate::{Cells, Dim, ElementKind, Interfaces, MeshError, Range};
 
 /// Marker for "no neighbouring element" in [`Faces::neighbor`].
 pub const NO_NEIGHBOR: u32 = u32::MAX;
@@ -79,6 +79,8 @@ pub struct Mesh<D: Dim> {
     faces: Faces,
     groups: Groups,
     interfaces: Interfaces,
+    #[serde(default, skip_serializing_if = "Cells::is_empty")]
+    cells: Cells,
     #[serde(skip)]
     _dim: PhantomData<D>,
 }
@@ -92,6 +94,8 @@ struct RawMesh {
     groups: Groups,
     #[serde(default)]
     interfaces: Interfaces,
+    #[serde(default)]
+    cells: Cells,
 }
 
 impl<D: Dim> TryFrom<RawMesh> for Mesh<D> {
@@ -99,6 +103,9 @@ impl<D: Dim> TryFrom<RawMesh> for Mesh<D> {
 
     fn try_from(raw: RawMesh) -> Result<Self, MeshError> {
         let mut mesh = Mesh::<D>::new(raw.coords, raw.elements)?;
+        if !raw.cells.is_empty() {
+            mesh.cells = raw.cells.checked::<D>(&mesh.coords, &mesh.elements)?;
+        }
         check_faces(&raw.faces, &mesh.faces)?;
         for (name, v) in raw.groups.nodes {
             mesh.add_node_group(name, v)?;
@@ -179,15 +186,7 @@ impl<D: Dim> Mesh<D> {
             return Err(MeshError::Empty);
         }
         let n_nodes = coords.len() / d;
-        if let Some(i) = coords.iter().position(|v| !v.is_finite()) {
-            return Err(MeshError::NonFiniteCoordinate { node: i / d });
-        }
-        if let Some(i) = coords.iter().position(|v| v.abs() > MAX_COORD) {
-            return Err(MeshError::CoordinateTooLarge {
-                node: i / d,
-                value: coords[i],
-            });
-        }
+        check_coords(&coords, d)?;
         let measure_name = if d == 2 { "area" } else { "volume" };
         let mut used = vec![false; n_nodes];
         let mut x = vec![0.0; npe * d];
@@ -251,8 +250,128 @@ impl<D: Dim> Mesh<D> {
             faces,
             groups: Groups::default(),
             interfaces: Interfaces::none(D::NODES_PER_FACE),
+            cells: Cells::default(),
             _dim: PhantomData,
         })
+    }
+
+    /// Builds a mesh from cells of any kind of this dimension (Tri3 and Quad4 in 2D, Tet4
+    /// and Hex8 in 3D, mixed freely): `kinds` holds one kind per cell, `conn` the cells'
+    /// nodes concatenated, each in the order of its kind ([`ElementKind`]). Quad4 and Hex8
+    /// cells are cut into simplices as [`crate::cells`] describes; the cell table is kept
+    /// ([`Mesh::cells`]). Besides the checks of [`Mesh::new`], each cell is checked and an
+    /// error names it ([`MeshError::BadCell`]): wrong dimension, bad or repeated node,
+    /// degenerate, inverted, twisted or non-convex.
+    pub fn from_cells(
+        coords: Vec<f64>,
+        kinds: Vec<ElementKind>,
+        conn: Vec<u32>,
+    ) -> Result<Self, MeshError> {
+        Self::build_cells(coords, kinds, conn, false)
+    }
+
+    /// Like [`Mesh::from_cells`] but reverses the node order of inverted cells instead
+    /// of failing (for imported meshes).
+    pub fn from_cells_reoriented(
+        coords: Vec<f64>,
+        kinds: Vec<ElementKind>,
+        conn: Vec<u32>,
+    ) -> Result<Self, MeshError> {
+        Self::build_cells(coords, kinds, conn, true)
+    }
+
+    fn build_cells(
+        coords: Vec<f64>,
+        kinds: Vec<ElementKind>,
+        conn: Vec<u32>,
+        reorient: bool,
+    ) -> Result<Self, MeshError> {
+        if coords.len() % D::D != 0 {
+            return Err(MeshError::CoordLength {
+                len: coords.len(),
+                dim: D::D,
+            });
+        }
+        check_coords(&coords, D::D)?;
+        let (cells, simplices) = crate::cells::decompose::<D>(&coords, &kinds, conn, reorient)?;
+        let mut mesh = Self::build(coords, simplices, false)?;
+        // A mesh of simplex cells only needs no cell table.
+        if cells.has_composite() {
+            mesh.cells = cells;
+        }
+        Ok(mesh)
+    }
+
+    /// Installs the cell table of a mesh whose elements were built from it.
+    pub(crate) fn set_cells(&mut self, cells: Cells) {
+        self.cells = cells;
+    }
+
+    /// The cell table of a mesh built from Quad4/Hex8 cells ([`Mesh::from_cells`]);
+    /// empty when every element is its own simplex cell.
+    pub fn cells(&self) -> &Cells {
+        &self.cells
+    }
+
+    /// Number of cells: the cell table's length, or the element count for a simplex mesh.
+    pub fn n_cells(&self) -> usize {
+        if self.cells.is_empty() {
+            self.n_elements()
+        } else {
+            self.cells.len()
+        }
+    }
+
+    /// Kind of cell `c`.
+    pub fn cell_kind(&self, c: usize) -> ElementKind {
+        if self.cells.is_empty() {
+            D::ELEMENT
+        } else {
+            self.cells.kind(c)
+        }
+    }
+
+    /// Nodes of cell `c`.
+    pub fn cell_nodes(&self, c: usize) -> &[u32] {
+        if self.cells.is_empty() {
+            self.element(c)
+        } else {
+            self.cells.nodes(c)
+        }
+    }
+
+    /// The simplex elements of cell `c`.
+    pub fn cell_elements(&self, c: usize) -> std::ops::Range<usize> {
+        if self.cells.is_empty() {
+            c..c + 1
+        } else {
+            self.cells.elements(c)
+        }
+    }
+
+    /// The cell element `e` belongs to.
+    pub fn cell_of(&self, e: usize) -> usize {
+        if self.cells.is_empty() {
+            e
+        } else {
+            self.cells.cell_of(e)
+        }
+    }
+
+    /// Centroid of cell `c` (the volume-weighted centroid of its simplices).
+    pub fn cell_centroid(&self, c: usize, out: &mut [f64]) {
+        let d = D::D;
+        out[..d].fill(0.0);
+        let (mut total, mut x) = (0.0, [0.0; 3]);
+        for e in self.cell_elements(c) {
+            let w = self.element_measure(e);
+            self.element_centroid(e, &mut x[..d]);
+            for k in 0..d {
+                out[k] += w * x[k];
+            }
+            total += w;
+        }
+        out[..d].iter_mut().for_each(|v| *v /= total);
     }
 
     /// Number of nodes.
@@ -477,11 +596,25 @@ impl<D: Dim> Mesh<D> {
             .collect())
     }
 
-    /// Elements in `range` (by centroid), ascending.
+    /// Elements in `range` (by centroid), ascending. The simplices of a Quad4/Hex8 cell
+    /// are selected together, by the cell's centroid and its first element's groups, so
+    /// that a range never cuts a cell.
     pub fn select_elements(&self, range: &Range) -> Result<Vec<u32>, MeshError> {
         self.check_range("element", &self.groups.elements, range)?;
         let g = &self.groups.elements;
         let mut c = [0.0; 3];
+        if !self.cells.is_empty() {
+            let mut out = Vec::new();
+            for cell in 0..self.cells.len() {
+                let els = self.cells.elements(cell);
+                let first = els.start as u32;
+                self.cell_centroid(cell, &mut c[..D::D]);
+                if range.contains(&c[..D::D], &|name| member(g, name, first)) {
+                    out.extend(els.map(|e| e as u32));
+                }
+            }
+            return Ok(out);
+        }
         Ok((0..self.n_elements() as u32)
             .filter(|&e| {
                 self.element_centroid(e as usize, &mut c[..D::D]);
@@ -525,6 +658,20 @@ impl<D: Dim> Mesh<D> {
         v.dedup();
         v
     }
+}
+
+/// Coordinates finite and at most [`MAX_COORD`] in magnitude.
+fn check_coords(coords: &[f64], d: usize) -> Result<(), MeshError> {
+    if let Some(i) = coords.iter().position(|v| !v.is_finite()) {
+        return Err(MeshError::NonFiniteCoordinate { node: i / d });
+    }
+    if let Some(i) = coords.iter().position(|v| v.abs() > MAX_COORD) {
+        return Err(MeshError::CoordinateTooLarge {
+            node: i / d,
+            value: coords[i],
+        });
+    }
+    Ok(())
 }
 
 fn member(map: &BTreeMap<String, Vec<u32>>, name: &str, i: u32) -> bool {
