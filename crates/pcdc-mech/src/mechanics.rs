@@ -1087,6 +1087,32 @@ impl<D: Dim> Physics<D> for Mechanics {
         } else {
             (String::new(), template.replace("/*coupling*/", ""))
         };
+        // Mixed Quad4/Hex8 cells: the cell's mean volumetric strain, and in 3D the
+        // rotation found by the trace pass ([`crate::mixed`]).
+        let mixed = self.mixed.is_some();
+        let template = match (mixed, d) {
+            (false, _) => template
+                .replace("/*mixed*/", "")
+                .replace("/*polar*/", "let r = polar_3d(f, r_prev);"),
+            (true, 2) => template.replace(
+                "/*mixed*/",
+                "if cell_count[e] > 1u {\n        let corr = 0.5 * (cell_mean(e) - trace_2d(h0, h1, h2, h3));\n        eps[0] = eps[0] + corr;\n        eps[1] = eps[1] + corr;\n    }",
+            ),
+            (true, _) => template
+                .replace(
+                    "/*polar*/",
+                    "var r = r_prev;\n    if cell_count[e] <= 1u {\n        r = polar_3d(f, r_prev);\n    }",
+                )
+                .replace(
+                    "/*mixed*/",
+                    "if cell_count[e] > 1u {\n        let corr = (cell_mean(e) - (eps[0] + eps[1] + eps[2])) / 3.0;\n        eps[0] = eps[0] + corr;\n        eps[1] = eps[1] + corr;\n        eps[2] = eps[2] + corr;\n    }",
+                ),
+        };
+        let mixed_lib = if mixed {
+            include_str!("shaders/mixed_lib.wgsl")
+        } else {
+            ""
+        };
         // Helper functions once per distinct model code.
         let mut functions = String::new();
         let mut seen: Vec<&str> = Vec::new();
@@ -1098,7 +1124,7 @@ impl<D: Dim> Physics<D> for Mechanics {
             }
         }
         let source = format!(
-            "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{coupling_src}{functions}{}{template}",
+            "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{coupling_src}{functions}{}{mixed_lib}{template}",
             splice.source
         );
         let polar_tol = match setup.precision() {
@@ -1110,6 +1136,45 @@ impl<D: Dim> Physics<D> for Mechanics {
         } else {
             ("rotation", setup.field(names::ROTATION)?)
         };
+        let cells = self.mixed.as_ref().map(|mx| {
+            let first = setup.upload("cell first element", GpuData::U32(mx.first.clone()));
+            let count = setup.upload("cell element count", GpuData::U32(mx.count.clone()));
+            let weight = setup.upload("cell volume share", GpuData::Real(mx.weight.clone()));
+            let trace = setup.upload("cell strain trace", GpuData::Real(vec![0.0; ne]));
+            [first, count, weight, trace]
+        });
+        let bind_cells = |k: Kernel| match cells {
+            Some([first, count, weight, trace]) => k
+                .bind("cell_first", first, Access::Read)
+                .bind("cell_count", count, Access::Read)
+                .bind("cell_weight", weight, Access::Read)
+                .bind("cell_trace", trace, Access::ReadWrite),
+            None => k,
+        };
+        if mixed {
+            let (helpers, body) = if d == 2 {
+                ("", include_str!("shaders/mixed_trace_2d.wgsl"))
+            } else {
+                let t = include_str!("shaders/element_3d.wgsl");
+                let at = t
+                    .find("fn kernel(e: u32)")
+                    .expect("the 3D template's kernel");
+                (&t[..at], include_str!("shaders/mixed_trace_3d.wgsl"))
+            };
+            let src = format!("alias Sym = array<Real, 6>;\n{helpers}{mixed_lib}{body}");
+            let trace_kernel = Kernel::new(format!("mechanics mixed trace {}", D::NAME), src, ne)
+                .const_u32("GEO", stride as u32)
+                .const_real("POLAR_TOL", polar_tol)
+                .bind("disp", setup.displacement(), Access::Read)
+                .bind("conn", conn, Access::Read)
+                .bind("geo", geo, Access::Read);
+            let trace_kernel = if d == 3 {
+                trace_kernel.bind("rotation", extra.1, Access::ReadWrite)
+            } else {
+                trace_kernel
+            };
+            setup.kernel(Phase::Forces, bind_cells(trace_kernel))?;
+        }
         let kernel = Kernel::new(format!("mechanics {}", D::NAME), source, ne)
             .const_u32("SLOT_FIRST", setup.slot_first())
             .const_u32("NSTATE", ns as u32)
@@ -1137,6 +1202,7 @@ impl<D: Dim> Physics<D> for Mechanics {
                 Access::Read,
             )
             .bind("slots", setup.slots(), Access::ReadWrite);
+        let kernel = bind_cells(kernel);
         let kernel = if coupled {
             self.coupling
                 .bind(setup, kernel, "mat_coupling", "material coupling")?
@@ -1354,6 +1420,31 @@ mod gpu_tests {
             // Two materials of one model share one WGSL function.
             let (_, src) = &s2[0];
             assert_eq!(src.matches("fn model_").count(), 1);
+        }
+    }
+
+    /// The mixed Quad4/Hex8 kernels: the trace pass and the element pass with the cell
+    /// mean, in 2D (mixed with Tri3) and 3D.
+    #[test]
+    fn mixed_cell_kernels_validate_with_naga() {
+        let m2 = builders::ring_mixed([1.0, 0.0], 0.3, 1.2, 0.1).unwrap();
+        let m3 = builders::cuboid_hexes([0.0; 3], [1.0; 3], 0.5).unwrap();
+        for p in [Precision::F64, Precision::F32] {
+            let s2 = offline_kernel_sources::<_>(&m2, vec![Box::new(mech(1e9))], p).unwrap();
+            let s3 = offline_kernel_sources::<_>(&m3, vec![Box::new(mech(1e9))], p).unwrap();
+            for (label, src) in s2.iter().chain(&s3) {
+                if let Err(e) = validate_wgsl(src) {
+                    panic!("{label} ({}) does not validate:\n{e}", p.name());
+                }
+            }
+            for s in [&s2, &s3] {
+                let mech: Vec<&String> = (s.iter())
+                    .filter(|(l, _)| l.starts_with("mechanics"))
+                    .map(|(_, src)| src)
+                    .collect();
+                assert_eq!(mech.len(), 2, "a trace pass and the element pass");
+                assert!(mech[1].contains("cell_mean(e)"));
+            }
         }
     }
 

@@ -52,7 +52,8 @@ fn kernel(e: u32) {
             cm1 = co - 1.0;
         }
     }
-    let eps = Sym(cm1 + co * h0 + si * h2, cm1 + co * h3 - si * h1, 0.0, 0.5 * (co * (h1 + h2) + si * (h3 - h0)), 0.0, 0.0);
+    var eps = Sym(cm1 + co * h0 + si * h2, cm1 + co * h3 - si * h1, 0.0, 0.5 * (co * (h1 + h2) + si * (h3 - h0)), 0.0, 0.0);
+    /*mixed*/
     let de = Sym(eps[0] - strain[3u * e], eps[1] - strain[3u * e + 1u], 0.0, eps[3] - strain[3u * e + 2u], 0.0, 0.0);
     strain[3u * e] = eps[0];
     strain[3u * e + 1u] = eps[1];

@@ -94,12 +94,13 @@ fn kernel(e: u32) {
     for (var k = 0u; k < 9u; k = k + 1u) {
         r_prev[k] = rotation[9u * e + k];
     }
-    let r = polar_3d(f, r_prev);
+    /*polar*/
     for (var k = 0u; k < 9u; k = k + 1u) {
         rotation[9u * e + k] = r[k];
     }
     let u = mul3_tn(r, f);
-    let eps = Sym(u[0] - 1.0, u[4] - 1.0, u[8] - 1.0, 0.5 * (u[1] + u[3]), 0.5 * (u[5] + u[7]), 0.5 * (u[2] + u[6]));
+    var eps = Sym(u[0] - 1.0, u[4] - 1.0, u[8] - 1.0, 0.5 * (u[1] + u[3]), 0.5 * (u[5] + u[7]), 0.5 * (u[2] + u[6]));
+    /*mixed*/
     var de: Sym;
     for (var k = 0u; k < 6u; k = k + 1u) {
         de[k] = eps[k] - strain[6u * e + k];
