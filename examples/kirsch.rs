@@ -13,6 +13,10 @@
 //! solve factorises on the host (faer) and is the same on both backends, so with
 //! `--backend gpu` only dynamic relaxation runs (on the device) and the example ends
 //! with its one RESULT line.
+//!
+//! Cells: `--element tri3|quad4|mixed` (default `tri3`): the graded triangle ring, a polar
+//! grid of Quad4 cells, or the same grid alternating Quad4 and Tri3 cells; the RESULT
+//! scene is then `kirsch_quad4` or `kirsch_mixed`.
 
 mod common;
 
@@ -22,6 +26,7 @@ use pcdc::compute::{Backend, BackendKind};
 use pcdc_validation::plot::Plot;
 use pcdc_validation::report::{out_dir, ResultLine};
 use pcdc_validation::scenes::kirsch::{self, Params, Solver};
+use pcdc_validation::scenes::Element;
 
 fn main() {
     pcdc_validation::report::finish(choose())
@@ -29,13 +34,25 @@ fn main() {
 
 /// Runs the scene on the backend named on the command line.
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let args = common::cli::command("kirsch", ABOUT).get_matches();
-    run(&common::cli::backend(&args)?)
+    let args = common::cli::with_element(
+        common::cli::command("kirsch", ABOUT),
+        &["tri3", "quad4", "mixed"],
+    )
+    .get_matches();
+    run(&common::cli::backend(&args)?, common::cli::element(&args)?)
 }
 
-fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+fn run(backend: &Backend, element: Element) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
     println!("backend: {}", backend.describe());
-    let full = Params::full();
+    let full = Params {
+        element,
+        ..Params::full()
+    };
+    let scene = match element {
+        Element::Simplex => "kirsch".to_string(),
+        e => format!("kirsch_{}", e.name()),
+    };
+    println!("cells: {}", element.name());
     println!("Kirsch: hole radius a = {} m, ring to 25a, E = 50 GPa, nu = 0.25, P1 = 10 MPa (x), P2 = 5 MPa (y)", full.radius);
     println!(
         "{:>10} {:>10} {:>9} {:>10} {:>8} {:>9}",
@@ -50,7 +67,7 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
     for &solver in solvers {
         for size in [0.1, 0.05, full.size_at_hole] {
             let vtu_dir = (size == full.size_at_hole)
-                .then(|| out_dir("kirsch"))
+                .then(|| out_dir(&scene))
                 .transpose()?;
             let p = Params {
                 size_at_hole: size,
@@ -102,7 +119,7 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
                 out.sigma_r.iter().map(|s| s / 1e6).collect(),
             );
     }
-    let png = out_dir("kirsch")?.join("kirsch.png");
+    let png = out_dir(&scene)?.join(format!("{scene}.png"));
     plot.save_png(&png)?;
     println!("plot: {}", png.display());
     Ok(finals
@@ -110,7 +127,7 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
         .map(|out| {
             ResultLine::new(
                 backend,
-                "kirsch",
+                &scene,
                 &format!("max_rel_err_{}", out.solver.name()),
                 out.error,
                 kirsch::TOL,

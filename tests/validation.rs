@@ -4,6 +4,7 @@
 use pcdc::compute::Backend;
 use pcdc_validation::scenes::{
     fracture_flow, injection, kirsch, radial_flow, unconfined_flow, vibration_energy, wave_speed,
+    Element,
 };
 
 fn cpu() -> Backend {
@@ -20,6 +21,25 @@ fn kirsch_direct_and_relaxation_within_3_percent() {
             solver, out.error, out.elements, out.steps, out.wall_s
         );
         assert!(out.error <= kirsch::TOL, "{solver:?}: error {}", out.error);
+    }
+}
+
+/// Kirsch on Quad4 cells and on a Tri3/Quad4 mix (direct solve; the relaxation path is
+/// the same element code, covered on triangles above and by the CPU–GPU parity tests).
+#[test]
+fn kirsch_on_quads_and_mixed_cells_within_3_percent() {
+    let cpu = cpu();
+    for element in [Element::Quad4, Element::Mixed] {
+        let p = kirsch::Params {
+            element,
+            ..kirsch::Params::reduced()
+        };
+        let out = kirsch::run(&cpu, &p, kirsch::Solver::Direct).unwrap();
+        eprintln!(
+            "kirsch {element:?}: error {:.4} elements {} wall {:.2}s",
+            out.error, out.elements, out.wall_s
+        );
+        assert!(out.error <= kirsch::TOL, "{element:?}: error {}", out.error);
     }
 }
 

@@ -46,3 +46,22 @@ pub fn choice(args: &ArgMatches) -> Result<BackendChoice, Box<dyn std::error::Er
 pub fn backend(args: &ArgMatches) -> Result<Backend, Box<dyn std::error::Error>> {
     Ok(Backend::open(choice(args)?)?)
 }
+
+/// Adds `--element` with the given choices (the first is the default).
+pub fn with_element(cmd: Command, choices: &'static [&'static str]) -> Command {
+    cmd.arg(
+        Arg::new("element")
+            .long("element")
+            .value_parser(clap::builder::PossibleValuesParser::new(choices))
+            .default_value(choices[0])
+            .help("The cells: simplices (tri3/tet4), Quad4, a Tri3/Quad4 mix, or Hex8"),
+    )
+}
+
+/// The cells `--element` names.
+pub fn element(
+    args: &ArgMatches,
+) -> Result<pcdc_validation::scenes::Element, Box<dyn std::error::Error>> {
+    let name = args.get_one::<String>("element").map_or("tri3", |s| s);
+    Ok(pcdc_validation::scenes::Element::parse(name)?)
+}

@@ -168,20 +168,20 @@ pub fn ring_quads(
     r_out: f64,
     size_in: f64,
 ) -> Result<Mesh<Dim2>, MeshError> {
-    ring_cells(center, r_in, r_out, size_in, f64::INFINITY)
+    ring_cells(center, r_in, r_out, size_in, false)
 }
 
-/// The [`ring_quads`] annulus as a mixed mesh: Quad4 cells out to the geometric mean
-/// radius `√(r_in r_out)`, Tri3 beyond it (each polar cell cut on alternating
-/// diagonals). Same requirements and groups as [`ring_quads`], plus the element groups
-/// `"quads"` and `"triangles"`.
+/// The [`ring_quads`] annulus as a mixed mesh: the polar cells alternate like a
+/// checkerboard between one Quad4 and two Tri3 (cut on alternating diagonals), so that
+/// both kinds meet everywhere. Same requirements and groups as [`ring_quads`], plus the
+/// element groups `"quads"` and `"triangles"`.
 pub fn ring_mixed(
     center: [f64; 2],
     r_in: f64,
     r_out: f64,
     size_in: f64,
 ) -> Result<Mesh<Dim2>, MeshError> {
-    ring_cells(center, r_in, r_out, size_in, (r_in * r_out).sqrt())
+    ring_cells(center, r_in, r_out, size_in, true)
 }
 
 fn ring_cells(
@@ -189,7 +189,7 @@ fn ring_cells(
     r_in: f64,
     r_out: f64,
     size_in: f64,
-    tri_beyond: f64,
+    mixed: bool,
 ) -> Result<Mesh<Dim2>, MeshError> {
     finite("center[0]", center[0])?;
     finite("center[1]", center[1])?;
@@ -224,19 +224,16 @@ fn ring_cells(
         }
     }
     let (mut kinds, mut conn) = (Vec::new(), Vec::new());
-    let mut tri_cells = Vec::new();
     for k in 0..rings {
-        let mid = 0.5 * (radius(k) + radius(k + 1));
         for i in 0..n {
             let (a, b, c, d) = (idx(k, i), idx(k + 1, i), idx(k + 1, i + 1), idx(k, i + 1));
             // Counter-clockwise: outwards, then around.
-            if mid < tri_beyond {
+            if !mixed || (i + k) % 2 == 0 {
                 kinds.push(ElementKind::Quad4);
                 conn.extend([a, b, c, d]);
             } else {
-                tri_cells.push(kinds.len());
                 kinds.extend([ElementKind::Tri3; 2]);
-                if (i + k) % 2 == 0 {
+                if (i / 2 + k) % 2 == 0 {
                     conn.extend([a, b, c, a, c, d]);
                 } else {
                     conn.extend([a, b, d, b, c, d]);
@@ -248,7 +245,6 @@ fn ring_cells(
         ("inner", (0..n).map(|i| idx(0, i)).collect()),
         ("outer", (0..n).map(|i| idx(rings, i)).collect()),
     ];
-    let mixed = !tri_cells.is_empty() && tri_beyond.is_finite();
     let mut mesh: Mesh<Dim2> = finish_cells(coords, kinds, conn, boundaries)?;
     if mixed {
         let (mut quads, mut tris) = (Vec::new(), Vec::new());

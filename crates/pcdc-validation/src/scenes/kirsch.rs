@@ -27,6 +27,7 @@ use pcdc_mech::{output, Boundary, Constraint, FaceStress, LinearElastic, Mechani
 use pcdc_mesh::{builders, Dim2, Mesh, Range};
 
 use crate::report::SceneError;
+use crate::scenes::Element;
 
 /// Far-field compression along x (Pa).
 pub const P1: f64 = 10.0e6;
@@ -63,6 +64,9 @@ pub struct Params {
     pub size_at_hole: f64,
     /// Folder for a VTU/PVD file of the solution (ParaView), if any.
     pub vtu_dir: Option<std::path::PathBuf>,
+    /// The cells: Tri3 (the graded ring), Quad4 or a Tri3/Quad4 mix (the polar grid of
+    /// [`builders::ring_quads`] / [`builders::ring_mixed`]).
+    pub element: Element,
 }
 
 impl Params {
@@ -72,6 +76,7 @@ impl Params {
             radius: 0.1,
             size_at_hole: 0.025,
             vtu_dir: None,
+            element: Element::Simplex,
         }
     }
     /// Reduced size for tests (a/20 at the hole).
@@ -80,6 +85,7 @@ impl Params {
             radius: 0.1,
             size_at_hole: 0.05,
             vtu_dir: None,
+            element: Element::Simplex,
         }
     }
 }
@@ -117,7 +123,17 @@ pub struct Outcome {
 pub fn mesh(p: &Params) -> Result<Mesh<Dim2>, SceneError> {
     let a = p.radius;
     let b = 25.0 * a;
-    let mut m = builders::ring([0.0, 0.0], a, b, p.size_at_hole * a, 2.5 * a)?;
+    let h = p.size_at_hole * a;
+    let mut m = match p.element {
+        Element::Simplex => builders::ring([0.0, 0.0], a, b, h, 2.5 * a)?,
+        Element::Quad4 => builders::ring_quads([0.0, 0.0], a, b, h)?,
+        Element::Mixed => builders::ring_mixed([0.0, 0.0], a, b, h)?,
+        Element::Hex8 => {
+            return Err(SceneError::Measurement(
+                "the Kirsch scene is plane strain: use tri3, quad4 or mixed cells, not hex8".into(),
+            ))
+        }
+    };
     let outer = m.select_nodes(&Range::group("outer"))?;
     let nearest = |m: &Mesh<Dim2>, x: f64, y: f64| -> u32 {
         *outer

@@ -38,3 +38,45 @@ pub enum Dimension {
     /// 3D, Tet4.
     Three,
 }
+
+/// The cells a scene meshes with (`--element` in the examples): simplices, or the
+/// Quad4/Hex8 cells of the mixed discretisation ([`pcdc_mech::mixed`]), or a Tri3/Quad4
+/// mix.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Element {
+    /// Tri3 in 2D, Tet4 in 3D (the default).
+    #[default]
+    Simplex,
+    /// Quad4 cells (2D).
+    Quad4,
+    /// Quad4 and Tri3 cells in one mesh (2D).
+    Mixed,
+    /// Hex8 cells (3D).
+    Hex8,
+}
+
+impl Element {
+    /// Short name: `simplex`, `quad4`, `mixed`, `hex8`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Element::Simplex => "simplex",
+            Element::Quad4 => "quad4",
+            Element::Mixed => "mixed",
+            Element::Hex8 => "hex8",
+        }
+    }
+
+    /// Parses an `--element` value: `tri3`, `tet4` or `simplex` (the same choice), `quad4`,
+    /// `mixed`, `hex8`.
+    pub fn parse(s: &str) -> Result<Self, crate::report::SceneError> {
+        match s {
+            "simplex" | "tri3" | "tet4" => Ok(Element::Simplex),
+            "quad4" => Ok(Element::Quad4),
+            "mixed" => Ok(Element::Mixed),
+            "hex8" => Ok(Element::Hex8),
+            _ => Err(crate::report::SceneError::Measurement(format!(
+                "unknown element '{s}': expected tri3, tet4, quad4, mixed or hex8"
+            ))),
+        }
+    }
+}

@@ -134,6 +134,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         radius: a,
         size_at_hole: p.size_at_hole,
         vtu_dir: None,
+        element: crate::scenes::Element::Simplex,
     })?;
     let e = LinearElastic::new(6.778e9, 0.21, 2500.0)?;
     let rock = MohrCoulomb::new(e, COHESION, FRICTION, 0.0, 1e6)?;
