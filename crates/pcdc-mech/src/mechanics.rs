@@ -682,6 +682,80 @@ impl Mechanics {
         });
     }
 
+    /// The third pass of the mixed discretisation: the nodal forces of a mixed-cell
+    /// element take the cell's mean pressure instead of its own, `f_a += −V_e (p̄ − p_e)
+    /// R ∇N_a`, so that they are the B̄ forces conjugate to the mixed strain
+    /// ([`crate::mixed`]); `p` is the in-plane mean (σ_xx + σ_yy)/2 in plane strain,
+    /// tr σ / 3 in 3D.
+    #[allow(clippy::too_many_arguments)]
+    fn mixed_pressure_forces<D: Dim>(
+        &self,
+        mx: &MixedCells,
+        inp: &StepInputs<'_>,
+        stress: &[f64],
+        extra: &[f64],
+        null: &[f64],
+        slots: &mut [f64],
+        backend: &Backend,
+    ) {
+        let (d, npe, nsym) = (D::D, D::NODES_PER_ELEM, D::NSYM);
+        let mean = |k: usize| {
+            let s = &stress[k * nsym..];
+            if d == 2 {
+                0.5 * (s[0] + s[1])
+            } else {
+                (s[0] + s[1] + s[2]) / 3.0
+            }
+        };
+        backend.install(|| {
+            slots
+                .par_chunks_mut(npe * d)
+                .enumerate()
+                .for_each(|(e, sl)| {
+                    if !mx.is_mixed(e) || null[e] != 0.0 {
+                        return;
+                    }
+                    let f = mx.first[e] as usize;
+                    let mut pbar = 0.0;
+                    for k in f..f + mx.count[e] as usize {
+                        pbar += mx.weight[k] * mean(k);
+                    }
+                    let dp = (pbar - mean(e)) * self.geo.volume[e];
+                    let m = &self.geo.dm_inv[e * d * d..(e + 1) * d * d];
+                    if d == 2 {
+                        let (co, si, _) = polar_2d_h(&self.displacement_gradient_2d(e, inp));
+                        let mut f0 = [0.0; 2];
+                        for a in 0..2 {
+                            let g = [m[2 * a], m[2 * a + 1]];
+                            let fa = [-dp * (co * g[0] - si * g[1]), -dp * (si * g[0] + co * g[1])];
+                            sl[2 * (a + 1)] += fa[0];
+                            sl[2 * (a + 1) + 1] += fa[1];
+                            f0[0] -= fa[0];
+                            f0[1] -= fa[1];
+                        }
+                        sl[0] += f0[0];
+                        sl[1] += f0[1];
+                    } else {
+                        let r = &extra[9 * e..9 * e + 9];
+                        let mut f0 = [0.0; 3];
+                        for a in 0..3 {
+                            for i in 0..3 {
+                                let fa = -dp
+                                    * (r[3 * i] * m[3 * a]
+                                        + r[3 * i + 1] * m[3 * a + 1]
+                                        + r[3 * i + 2] * m[3 * a + 2]);
+                                sl[3 * (a + 1) + i] += fa;
+                                f0[i] -= fa;
+                            }
+                        }
+                        for i in 0..3 {
+                            sl[i] += f0[i];
+                        }
+                    }
+                });
+        });
+    }
+
     /// Displacement gradient H = [u₁ − u₀, u₂ − u₀] D_m⁻¹ of triangle `e` (row-major).
     #[inline]
     fn displacement_gradient_2d(&self, e: usize, inp: &StepInputs<'_>) -> [f64; 4] {
@@ -1009,6 +1083,9 @@ impl<D: Dim> Physics<D> for Mechanics {
                 });
         });
         self.coupling.values = cvalues;
+        if let Some(mx) = &self.mixed {
+            self.mixed_pressure_forces::<D>(mx, &inp, stress, extra, null, slots, ctx.backend);
+        }
         Ok(())
     }
 
@@ -1209,7 +1286,34 @@ impl<D: Dim> Physics<D> for Mechanics {
         } else {
             kernel
         };
-        setup.kernel(Phase::Forces, kernel)
+        setup.kernel(Phase::Forces, kernel)?;
+        if mixed {
+            let body = if d == 2 {
+                include_str!("shaders/mixed_pressure_2d.wgsl")
+            } else {
+                include_str!("shaders/mixed_pressure_3d.wgsl")
+            };
+            let pressure = Kernel::new(format!("mechanics mixed pressure {}", D::NAME), body, ne)
+                .const_u32("SLOT_FIRST", setup.slot_first())
+                .const_u32("GEO", stride as u32)
+                .bind("disp", setup.displacement(), Access::Read)
+                .bind("conn", conn, Access::Read)
+                .bind("geo", geo, Access::Read)
+                .bind("stress", setup.field(names::STRESS)?, Access::Read)
+                .bind(
+                    "element_null",
+                    setup.field(names::ELEMENT_NULL)?,
+                    Access::Read,
+                )
+                .bind("slots", setup.slots(), Access::ReadWrite);
+            let pressure = if d == 3 {
+                pressure.bind("rotation", extra.1, Access::Read)
+            } else {
+                pressure
+            };
+            setup.kernel(Phase::Forces, bind_cells(pressure))?;
+        }
+        Ok(())
     }
 
     fn linear_stiffness(
@@ -1442,7 +1546,7 @@ mod gpu_tests {
                     .filter(|(l, _)| l.starts_with("mechanics"))
                     .map(|(_, src)| src)
                     .collect();
-                assert_eq!(mech.len(), 2, "a trace pass and the element pass");
+                assert_eq!(mech.len(), 3, "the trace, element and pressure passes");
                 assert!(mech[1].contains("cell_mean(e)"));
             }
         }

@@ -17,7 +17,18 @@
 //! co-rotated strain is invariant, and in 2D needs no rotation at all
 //! (`tr U = |(F₀₀ + F₁₁, F₁₀ − F₀₁)|`). The constitutive model is called per simplex
 //! with the mixed strain increment, so every model, plastic or viscous, sees the
-//! non-locking strain. The linear stiffness is the matching B̄ form.
+//! non-locking strain. The nodal forces are the B̄ forces conjugate to that strain,
+//! `f = Σ_e V_e B̄_eᵀ σ_e`, which is each simplex's own force with its pressure replaced
+//! by the cell's volume-weighted mean pressure p̄ (a third pass adds
+//! `−V_e (p̄ − p_e) R ∇N_a`; p is (σ_xx + σ_yy)/2 in plane strain, tr σ/3 in 3D): so
+//! the forces do work on the mixed strain exactly, as FLAC's zones average isotropic
+//! stress and strain rate. The linear stiffness is the matching B̄ form
+//! `K = Σ_e V_e B̄_eᵀ C B̄_e`.
+//!
+//! Passes per step: (1) the trace of every mixed-cell element's strain (in 3D with its
+//! rotation, stored for pass 2), (2) the element pass with the cell-mean volumetric
+//! strain, (3) the pressure correction of the forces. Meshes without Quad4/Hex8 cells
+//! run pass 2 alone, unchanged.
 
 use pcdc_mesh::{Dim, Mesh};
 

@@ -4,7 +4,9 @@
 //! cells refused by name.
 
 use pcdc_compute::{Backend, Simulation, StaticOptions};
-use pcdc_mech::{output, Boundary, Constraint, FaceStress, LinearElastic, Mechanics};
+use pcdc_mech::{
+    output, Boundary, Constraint, FaceStress, InitialStress, LinearElastic, Mechanics,
+};
 use pcdc_mesh::{builders, Dim, Dim2, Dim3, ElementKind, Mesh, MeshError, Range};
 use proptest::prelude::*;
 
@@ -339,4 +341,154 @@ fn fdem_split_keeps_cells_whole() {
         let el = j.elements;
         assert_ne!(s.cell_of(el[0] as usize), s.cell_of(el[1] as usize));
     }
+}
+
+/// The nodal forces of mixed cells are the B̄ forces conjugate to the mixed strain: for
+/// any virtual displacement δu, f·δu = −Σ_e V_e σ_e : δε'_e with
+/// δε'_e = sym ∇δu_e + (θ̄ − θ_e)/d I. The stress varies inside the cells (a depth
+/// gradient of every component, sampled at the simplex centroids), so the mean stress
+/// differs between the simplices of a cell and a force taken from each simplex's own
+/// pressure would fail this by the pressure difference.
+#[test]
+fn mixed_forces_are_conjugate_to_the_mixed_strain() {
+    fn check<D: Dim>(mesh: Mesh<D>) {
+        let d = D::D;
+        let grad = InitialStress::Gradient {
+            surface: 1.0,
+            at_surface: [-1e6, -2e6, -1.5e6, 3e5, 2e5, -1e5],
+            per_metre: [4e6, 9e6, 2e6, -5e6, 3e6, 7e6],
+        };
+        let mut sim = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+            .physics(
+                Mechanics::new()
+                    .material(Range::All, rock(0.3))
+                    .initial_stress_field(Range::All, grad),
+            )
+            .build()
+            .unwrap();
+        let f = sim.evaluate_forces().unwrap().to_vec();
+        let stress = sim.field("stress").unwrap().to_vec();
+        let mesh = sim.mesh();
+        let du: Vec<f64> = (0..mesh.n_nodes() * d)
+            .map(|i| ((i * 7919) % 101) as f64 / 101.0 - 0.5)
+            .collect();
+        let power: f64 = f.iter().zip(&du).map(|(a, b)| a * b).sum();
+        // −Σ V σ : δε' with the element gradients from the reference coordinates.
+        let npe = D::NODES_PER_ELEM;
+        let mut sym = vec![[0.0; 6]; mesh.n_elements()];
+        let mut vol = vec![0.0; mesh.n_elements()];
+        for e in 0..mesh.n_elements() {
+            let mut x = [0.0; 12];
+            mesh.element_coords(e, &mut x[..npe * d]);
+            vol[e] = mesh.element_measure(e);
+            let conn = mesh.element(e);
+            // ∇δu = [δu_a − δu_0] D_m⁻¹ via solving D_mᵀ.
+            let dm = |i: usize, j: usize| x[(j + 1) * d + i] - x[i];
+            let g = if d == 2 {
+                let det = dm(0, 0) * dm(1, 1) - dm(0, 1) * dm(1, 0);
+                let inv = [
+                    dm(1, 1) / det,
+                    -dm(0, 1) / det,
+                    -dm(1, 0) / det,
+                    dm(0, 0) / det,
+                ];
+                let mut h = [[0.0; 3]; 3];
+                for i in 0..2 {
+                    let dd = |a: usize| du[conn[a] as usize * 2 + i] - du[conn[0] as usize * 2 + i];
+                    for j in 0..2 {
+                        h[i][j] = dd(1) * inv[j] + dd(2) * inv[2 + j];
+                    }
+                }
+                h
+            } else {
+                let m: Vec<f64> = (0..9).map(|k| dm(k / 3, k % 3)).collect();
+                let mm = nalgebra_free_inverse(&m);
+                let mut h = [[0.0; 3]; 3];
+                for i in 0..3 {
+                    let dd = |a: usize| du[conn[a] as usize * 3 + i] - du[conn[0] as usize * 3 + i];
+                    for j in 0..3 {
+                        h[i][j] = (0..3).map(|a| dd(a + 1) * mm[3 * a + j]).sum();
+                    }
+                }
+                h
+            };
+            sym[e] = [
+                g[0][0],
+                g[1][1],
+                g[2][2],
+                0.5 * (g[0][1] + g[1][0]),
+                0.5 * (g[1][2] + g[2][1]),
+                0.5 * (g[0][2] + g[2][0]),
+            ];
+        }
+        let mut work = 0.0;
+        let mut naive = 0.0;
+        for c in 0..mesh.n_cells() {
+            let els = mesh.cell_elements(c);
+            let tr = |e: usize| sym[e][0] + sym[e][1] + if d == 3 { sym[e][2] } else { 0.0 };
+            let total: f64 = els.clone().map(|e| vol[e]).sum();
+            let mean: f64 = els.clone().map(|e| vol[e] * tr(e)).sum::<f64>() / total;
+            for e in els {
+                let s = &stress[e * D::NSYM..(e + 1) * D::NSYM];
+                let mut eps = sym[e];
+                let corr = (mean - tr(e)) / d as f64;
+                for v in eps.iter_mut().take(d) {
+                    *v += corr;
+                }
+                let (sd, nd) = if d == 2 {
+                    (
+                        s[0] * eps[0] + s[1] * eps[1] + 2.0 * s[2] * eps[3],
+                        s[0] * sym[e][0] + s[1] * sym[e][1] + 2.0 * s[2] * sym[e][3],
+                    )
+                } else {
+                    let dot = |v: &[f64; 6]| {
+                        s[0] * v[0]
+                            + s[1] * v[1]
+                            + s[2] * v[2]
+                            + 2.0 * (s[3] * v[3] + s[4] * v[4] + s[5] * v[5])
+                    };
+                    (dot(&eps), dot(&sym[e]))
+                };
+                work -= vol[e] * sd;
+                naive -= vol[e] * nd;
+            }
+        }
+        let scale = power.abs().max(work.abs());
+        println!(
+            "{}: f·δu {power:.6e}, −Σ V σ:δε' {work:.6e}, with the own pressures {naive:.6e}",
+            D::NAME
+        );
+        assert!((power - work).abs() < 1e-9 * scale, "{power} vs {work}");
+        assert!(
+            (naive - work).abs() > 1e-6 * scale,
+            "the test must see the pressure difference"
+        );
+    }
+    check(distorted(
+        &builders::rectangle_quads(0.0, 0.0, 1.0, 1.0, 0.2).unwrap(),
+        5,
+        0.1,
+    ));
+    check(distorted(
+        &builders::cuboid_hexes([0.0; 3], [1.0; 3], 0.34).unwrap(),
+        5,
+        0.1,
+    ));
+}
+
+/// Inverse of a row-major 3x3 matrix (cofactors).
+fn nalgebra_free_inverse(a: &[f64]) -> [f64; 9] {
+    let det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
+        + a[2] * (a[3] * a[7] - a[4] * a[6]);
+    [
+        (a[4] * a[8] - a[5] * a[7]) / det,
+        (a[2] * a[7] - a[1] * a[8]) / det,
+        (a[1] * a[5] - a[2] * a[4]) / det,
+        (a[5] * a[6] - a[3] * a[8]) / det,
+        (a[0] * a[8] - a[2] * a[6]) / det,
+        (a[2] * a[3] - a[0] * a[5]) / det,
+        (a[3] * a[7] - a[4] * a[6]) / det,
+        (a[1] * a[6] - a[0] * a[7]) / det,
+        (a[0] * a[4] - a[1] * a[3]) / det,
+    ]
 }
