@@ -5,6 +5,9 @@
 //! `out/vibration_energy/vibration_energy.png` and ends with the RESULT line (worst of
 //! 2D and 3D at the finest size).
 //!
+//! Cells: `--element tet4|hex8` (default `tet4`); with `hex8` only the 3D bar runs, on
+//! Hex8 cells, and the RESULT case gets the suffix `_hex8`.
+//!
 //! Backend: `--backend cpu|gpu` (default `cpu`, or `PCDC_BACKEND`) and, on the GPU,
 //! `--precision f64|f32` (default f64 where the adapter supports it, or
 //! `PCDC_PRECISION`); the RESULT line carries `backend=` and `precision=`, e.g.
@@ -18,6 +21,7 @@ use pcdc::compute::Backend;
 use pcdc_validation::plot::Plot;
 use pcdc_validation::report::{out_dir, ResultLine};
 use pcdc_validation::scenes::vibration_energy::{self, Params};
+use pcdc_validation::scenes::Element;
 
 fn main() {
     pcdc_validation::report::finish(choose())
@@ -25,11 +29,21 @@ fn main() {
 
 /// Runs the scene on the backend named on the command line.
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let args = common::cli::command("vibration_energy", ABOUT).get_matches();
-    run(&common::cli::backend(&args)?)
+    let args = common::cli::with_element(
+        common::cli::command("vibration_energy", ABOUT),
+        &["tet4", "hex8"],
+    )
+    .get_matches();
+    run(&common::cli::backend(&args)?, common::cli::element(&args)?)
 }
 
-fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+fn run(backend: &Backend, element: Element) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    let hex8 = element == Element::Hex8;
+    let case = if hex8 {
+        "vibration_energy_hex8"
+    } else {
+        "vibration_energy"
+    };
     println!("backend: {}", backend.describe());
     let full = Params::full();
     println!(
@@ -46,10 +60,15 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
             size,
             ..full.clone()
         };
-        for (dim, out) in [
-            ("2d", vibration_energy::run_2d(backend, &p)?),
-            ("3d", vibration_energy::run_3d(backend, &p)?),
-        ] {
+        let runs = if hex8 {
+            vec![("hex8", vibration_energy::run_3d_hex8(backend, &p)?)]
+        } else {
+            vec![
+                ("2d", vibration_energy::run_2d(backend, &p)?),
+                ("3d", vibration_energy::run_3d(backend, &p)?),
+            ]
+        };
+        for (dim, out) in runs {
             println!(
                 "{:>4} {:>8.4} {:>9} {:>11.3e} {:>8} {:>8.3}",
                 dim, size, out.elements, out.drift, out.steps, out.wall_s
@@ -80,7 +99,7 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
             );
     }
     plot = plot.line("exact total", vec![0.0, full.periods], vec![1.0, 1.0]);
-    let png = out_dir("vibration_energy")?.join("vibration_energy.png");
+    let png = out_dir(case)?.join(format!("{case}.png"));
     plot.save_png(&png)?;
     println!("plot: {}", png.display());
     let worst = finals
@@ -89,7 +108,7 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
         .expect("two runs");
     Ok(vec![ResultLine::new(
         backend,
-        "vibration_energy",
+        case,
         "max_rel_energy_drift",
         worst.1.drift,
         vibration_energy::TOL,

@@ -4,6 +4,9 @@
 //! `out/wave_speed/wave_speed.png` (probe velocities against time, with the analytic
 //! arrival times) and ends with the RESULT line (worst of 2D and 3D at the finest size).
 //!
+//! Cells: `--element tet4|hex8` (default `tet4`); with `hex8` only the 3D bar runs, on
+//! Hex8 cells, and the RESULT case gets the suffix `_hex8`.
+//!
 //! Backend: `--backend cpu|gpu` (default `cpu`, or `PCDC_BACKEND`) and, on the GPU,
 //! `--precision f64|f32` (default f64 where the adapter supports it, or
 //! `PCDC_PRECISION`); the RESULT line carries `backend=` and `precision=`, e.g.
@@ -18,6 +21,7 @@ use pcdc::compute::Backend;
 use pcdc_validation::plot::Plot;
 use pcdc_validation::report::{out_dir, ResultLine};
 use pcdc_validation::scenes::wave_speed::{self, Params};
+use pcdc_validation::scenes::Element;
 
 fn main() {
     pcdc_validation::report::finish(choose())
@@ -25,11 +29,19 @@ fn main() {
 
 /// Runs the scene on the backend named on the command line.
 fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
-    let args = common::cli::command("wave_speed", ABOUT).get_matches();
-    run(&common::cli::backend(&args)?)
+    let args =
+        common::cli::with_element(common::cli::command("wave_speed", ABOUT), &["tet4", "hex8"])
+            .get_matches();
+    run(&common::cli::backend(&args)?, common::cli::element(&args)?)
 }
 
-fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+fn run(backend: &Backend, element: Element) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
+    let hex8 = element == Element::Hex8;
+    let case = if hex8 {
+        "wave_speed_hex8"
+    } else {
+        "wave_speed"
+    };
     println!("backend: {}", backend.describe());
     let full = Params::full();
     println!(
@@ -43,10 +55,15 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
     let mut finals = Vec::new();
     for size in [4.0 * full.size, 2.0 * full.size, full.size] {
         let p = Params { size };
-        for (dim, out) in [
-            ("2d", wave_speed::run_2d(backend, &p)?),
-            ("3d", wave_speed::run_3d(backend, &p)?),
-        ] {
+        let runs = if hex8 {
+            vec![("hex8", wave_speed::run_3d_hex8(backend, &p)?)]
+        } else {
+            vec![
+                ("2d", wave_speed::run_2d(backend, &p)?),
+                ("3d", wave_speed::run_3d(backend, &p)?),
+            ]
+        };
+        for (dim, out) in runs {
             println!(
                 "{:>4} {:>8.4} {:>9} {:>10.2} {:>9.5} {:>7} {:>8.3}",
                 dim, size, out.elements, out.c_num, out.error, out.steps, out.wall_s
@@ -67,7 +84,11 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
     let (sx2, sy2) = step(0.75);
     let ms: Vec<f64> = o2.t.iter().map(|t| t * 1e3).collect();
     let plot = Plot::new(
-        "Velocity step in a bar on rollers (2D)",
+        if hex8 {
+            "Velocity step in a bar on rollers (3D, Hex8)"
+        } else {
+            "Velocity step in a bar on rollers (2D)"
+        },
         "time (ms)",
         "mean x-velocity (m/s)",
     )
@@ -75,7 +96,7 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
     .line("exact front at x = 0.75 m", sx2, sy2)
     .points("FDEM x = 0.25 m", ms.clone(), o2.v1.clone())
     .points("FDEM x = 0.75 m", ms, o2.v2.clone());
-    let png = out_dir("wave_speed")?.join("wave_speed.png");
+    let png = out_dir(case)?.join(format!("{case}.png"));
     plot.save_png(&png)?;
     println!("plot: {}", png.display());
     let worst = finals
@@ -84,7 +105,7 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
         .expect("two runs");
     Ok(vec![ResultLine::new(
         backend,
-        "wave_speed",
+        case,
         "rel_err_p_wave_speed",
         worst.1.error,
         wave_speed::TOL,

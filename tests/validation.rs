@@ -49,6 +49,7 @@ fn wave_speed_within_2_percent_2d_and_3d() {
     for (name, out) in [
         ("2d", wave_speed::run_2d(&cpu, &p).unwrap()),
         ("3d", wave_speed::run_3d(&cpu, &p).unwrap()),
+        ("3d hex8", wave_speed::run_3d_hex8(&cpu, &p).unwrap()),
     ] {
         eprintln!(
             "wave {name}: c_num {:.1} c {:.1} error {:.4} elements {} steps {}",
@@ -91,6 +92,7 @@ fn vibration_energy_drift_below_half_percent_2d_and_3d() {
     for (name, out) in [
         ("2d", vibration_energy::run_2d(&cpu, &p).unwrap()),
         ("3d", vibration_energy::run_3d(&cpu, &p).unwrap()),
+        ("3d hex8", vibration_energy::run_3d_hex8(&cpu, &p).unwrap()),
     ] {
         eprintln!(
             "energy {name}: drift {:.2e} elements {} steps {}",

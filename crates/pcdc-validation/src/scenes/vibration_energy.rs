@@ -143,3 +143,12 @@ pub fn run_3d(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         p,
     )
 }
+
+/// The 3D block of [`run_3d`] meshed with Hex8 cells of the same size.
+pub fn run_3d_hex8(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
+    run_on(
+        backend,
+        builders::cuboid_hexes([0.0; 3], [1.0, 0.25, 0.25], 2.5 * p.size)?,
+        p,
+    )
+}

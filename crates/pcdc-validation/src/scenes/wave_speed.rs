@@ -174,3 +174,9 @@ pub fn run_3d(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     let mesh = builders::cuboid([0.0; 3], [LENGTH, 0.05, 0.05], 2.0 * p.size)?;
     run_on(backend, mesh, &["ymin", "ymax", "zmin", "zmax"])
 }
+
+/// The 3D bar of [`run_3d`] meshed with Hex8 cells of the same size.
+pub fn run_3d_hex8(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
+    let mesh = builders::cuboid_hexes([0.0; 3], [LENGTH, 0.05, 0.05], 2.0 * p.size)?;
+    run_on(backend, mesh, &["ymin", "ymax", "zmin", "zmax"])
+}
