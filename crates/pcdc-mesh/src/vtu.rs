@@ -434,6 +434,11 @@ enum Source<'a> {
     Connectivity(&'a [u32]),
     Offsets(usize),
     Types(u8),
+    /// Per-cell values computed for the output (Quad4/Hex8 cells).
+    F64Owned(Vec<f64>, Expand),
+    I32Owned(Vec<i32>),
+    OffsetList(Vec<i64>),
+    TypeList(Vec<u8>),
 }
 
 /// One `DataArray` element of the output file.
@@ -450,18 +455,22 @@ struct OutArray<'a> {
 impl OutArray<'_> {
     fn vtk_type(&self) -> &'static str {
         match self.source {
-            Source::F64(..) => "Float64",
-            Source::I32(_) => "Int32",
-            Source::Connectivity(_) | Source::Offsets(_) => "Int64",
-            Source::Types(_) => "UInt8",
+            Source::F64(..) | Source::F64Owned(..) => "Float64",
+            Source::I32(_) | Source::I32Owned(_) => "Int32",
+            Source::Connectivity(_) | Source::Offsets(_) | Source::OffsetList(_) => "Int64",
+            Source::Types(_) | Source::TypeList(_) => "UInt8",
         }
     }
 
     fn value_size(&self) -> u64 {
         match self.source {
-            Source::F64(..) | Source::Connectivity(_) | Source::Offsets(_) => 8,
-            Source::I32(_) => 4,
-            Source::Types(_) => 1,
+            Source::F64(..)
+            | Source::F64Owned(..)
+            | Source::Connectivity(_)
+            | Source::Offsets(_)
+            | Source::OffsetList(_) => 8,
+            Source::I32(_) | Source::I32Owned(_) => 4,
+            Source::Types(_) | Source::TypeList(_) => 1,
         }
     }
 
@@ -479,7 +488,34 @@ impl OutArray<'_> {
             if ascii {
                 w.write_all(INDENT.as_bytes())?;
             }
-            match self.source {
+            let owned_f64;
+            let owned_i32;
+            let source = match &self.source {
+                Source::F64Owned(v, e) => {
+                    owned_f64 = Source::F64(v, *e);
+                    &owned_f64
+                }
+                Source::I32Owned(v) => {
+                    owned_i32 = Source::I32(v);
+                    &owned_i32
+                }
+                Source::OffsetList(v) => {
+                    write_scalar(w, ascii, &v[i].to_le_bytes(), &v[i].to_string())?;
+                    if ascii {
+                        w.write_all(b"\n")?;
+                    }
+                    continue;
+                }
+                Source::TypeList(v) => {
+                    write_scalar(w, ascii, &[v[i]], &v[i].to_string())?;
+                    if ascii {
+                        w.write_all(b"\n")?;
+                    }
+                    continue;
+                }
+                other => other,
+            };
+            match *source {
                 Source::F64(v, expand) => {
                     match expand {
                         Expand::Copy => t[..nc].copy_from_slice(&v[i * nc..(i + 1) * nc]),
@@ -537,12 +573,25 @@ impl OutArray<'_> {
                         w.write_all(&[t])?;
                     }
                 }
+                Source::F64Owned(..)
+                | Source::I32Owned(_)
+                | Source::OffsetList(_)
+                | Source::TypeList(_) => unreachable!("resolved above"),
             }
             if ascii {
                 w.write_all(b"\n")?;
             }
         }
         Ok(())
+    }
+}
+
+/// Writes one scalar as bytes or as text.
+fn write_scalar(w: &mut impl Write, ascii: bool, bytes: &[u8], text: &str) -> io::Result<()> {
+    if ascii {
+        w.write_all(text.as_bytes())
+    } else {
+        w.write_all(bytes)
     }
 }
 
@@ -563,6 +612,9 @@ impl<'a> Grid<'a> {
         point_data: &[DataArray<'a>],
         cell_data: &[DataArray<'a>],
     ) -> io::Result<Self> {
+        if mesh.cells().has_composite() {
+            return Self::of_mesh_cells(mesh, points, point_data, cell_data);
+        }
         let cells = Cells {
             points: points.unwrap_or(mesh.coords()),
             connectivity: mesh.elements(),
@@ -576,6 +628,100 @@ impl<'a> Grid<'a> {
             cell_data,
             ("nodes", "elements"),
         )
+    }
+
+    /// A mesh with Quad4/Hex8 cells: written as its cells (VTK_QUAD, VTK_HEXAHEDRON,
+    /// VTK_TRIANGLE, VTK_TETRA), each cell's data the volume-weighted mean of its
+    /// simplices' values (integers: its first simplex's value).
+    fn of_mesh_cells<D: Dim>(
+        mesh: &'a Mesh<D>,
+        points: Option<&'a [f64]>,
+        point_data: &[DataArray<'a>],
+        cell_data: &[DataArray<'a>],
+    ) -> io::Result<Self> {
+        let ne = mesh.n_elements();
+        // The element-level checks, then the per-cell means.
+        let per_element = out_arrays::<D>("cell", "elements", cell_data, ne)?;
+        let simplex = Cells {
+            points: points.unwrap_or(mesh.coords()),
+            connectivity: mesh.elements(),
+            nodes_per_cell: D::NODES_PER_ELEM,
+            cell_type: D::ELEMENT.vtk_cell_type(),
+        };
+        let mut grid = Self::of_cells::<D>(
+            &simplex,
+            mesh.n_nodes(),
+            point_data,
+            &[],
+            ("nodes", "elements"),
+        )?;
+        let cells = mesh.cells();
+        let nc = cells.len();
+        let weights: Vec<f64> = (0..ne).map(|e| mesh.element_measure(e)).collect();
+        let mut offsets = Vec::with_capacity(nc);
+        let mut end = 0i64;
+        for c in 0..nc {
+            end += cells.nodes(c).len() as i64;
+            offsets.push(end);
+        }
+        grid.n_cells = nc;
+        grid.geometry[1] = OutArray {
+            name: "connectivity",
+            ncomp: 1,
+            write_ncomp: false,
+            n_tuples: cells.all_nodes().len(),
+            source: Source::Connectivity(cells.all_nodes()),
+        };
+        grid.geometry[2] = OutArray {
+            name: "offsets",
+            ncomp: 1,
+            write_ncomp: false,
+            n_tuples: nc,
+            source: Source::OffsetList(offsets),
+        };
+        grid.geometry[3] = OutArray {
+            name: "types",
+            ncomp: 1,
+            write_ncomp: false,
+            n_tuples: nc,
+            source: Source::TypeList(cells.kinds().iter().map(|k| k.vtk_cell_type()).collect()),
+        };
+        grid.cell_data = per_element
+            .into_iter()
+            .zip(cell_data)
+            .map(|(out, input)| {
+                let source = match *input {
+                    DataArray::Int { values, .. } => {
+                        Source::I32Owned((0..nc).map(|c| values[cells.elements(c).start]).collect())
+                    }
+                    _ => {
+                        let (values, expand) = match out.source {
+                            Source::F64(v, e) => (v, e),
+                            _ => unreachable!("a float array"),
+                        };
+                        let stride = input.input_stride::<D>();
+                        let mut mean = vec![0.0; nc * stride];
+                        for c in 0..nc {
+                            let els = cells.elements(c);
+                            let total: f64 = els.clone().map(|e| weights[e]).sum();
+                            for e in els {
+                                for k in 0..stride {
+                                    mean[c * stride + k] +=
+                                        weights[e] / total * values[e * stride + k];
+                                }
+                            }
+                        }
+                        Source::F64Owned(mean, expand)
+                    }
+                };
+                OutArray {
+                    n_tuples: nc,
+                    source,
+                    ..out
+                }
+            })
+            .collect();
+        Ok(grid)
     }
 
     /// `n_points`: the points expected in `cells.points` (stride D).
@@ -806,6 +952,59 @@ mod tests {
             .unwrap_or_else(|| panic!("no {attr} in {elem}"))
             + key.len();
         elem[a..a + elem[a..].find('"').unwrap()].to_string()
+    }
+
+    /// A mesh with Quad4 and Tri3 cells is written as those cells, each with the
+    /// volume-weighted mean of its simplices' data; the binary file has the same layout.
+    #[test]
+    fn quad_and_triangle_cells_are_written_as_cells() {
+        let mesh = crate::builders::ring_mixed([0.0, 0.0], 1.0, 2.0, 0.8).unwrap();
+        let ne = mesh.n_elements();
+        let nc = mesh.n_cells();
+        assert!(nc < ne);
+        let scalar: Vec<f64> = (0..ne).map(|e| e as f64).collect();
+        let ids: Vec<i32> = (0..ne as i32).collect();
+        let dir = tmp_dir("quad_cells");
+        let path = dir.join("mixed.vtu");
+        let data = [
+            DataArray::Scalar {
+                name: "s",
+                values: &scalar,
+            },
+            DataArray::Int {
+                name: "id",
+                values: &ids,
+            },
+        ];
+        write_vtu_ascii(&path, &mesh, None, &[], &data).unwrap();
+        let xml = std::fs::read_to_string(&path).unwrap();
+        assert!(xml.contains(&format!("NumberOfCells=\"{nc}\"")));
+        let types = ascii_array(&xml, "types");
+        assert!(types.contains(&9.0) && types.contains(&5.0));
+        let offsets = ascii_array(&xml, "offsets");
+        assert_eq!(
+            *offsets.last().unwrap() as usize,
+            mesh.cells().all_nodes().len()
+        );
+        let (s, id) = (ascii_array(&xml, "s"), ascii_array(&xml, "id"));
+        for c in 0..nc {
+            let els = mesh.cell_elements(c);
+            let total: f64 = els.clone().map(|e| mesh.element_measure(e)).sum();
+            let want: f64 = els
+                .clone()
+                .map(|e| mesh.element_measure(e) * e as f64)
+                .sum::<f64>()
+                / total;
+            assert!(
+                (s[c] - want).abs() < 1e-12 * want.abs().max(1.0),
+                "cell {c}: {} vs {want}",
+                s[c]
+            );
+            assert_eq!(id[c] as usize, els.start);
+        }
+        write_vtu(dir.join("mixed_bin.vtu"), &mesh, None, &[], &data).unwrap();
+        let bin = std::fs::read(dir.join("mixed_bin.vtu")).unwrap();
+        assert!(find(&bin, b"NumberOfCells") > 0);
     }
 
     #[test]
