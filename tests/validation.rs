@@ -3,8 +3,8 @@
 
 use pcdc::compute::Backend;
 use pcdc_validation::scenes::{
-    fracture_flow, injection, kirsch, radial_flow, unconfined_flow, vibration_energy, wave_speed,
-    Element,
+    fracture_flow, injection, kirsch, radial_flow, slope_excavation, unconfined_flow,
+    vibration_energy, wave_speed, Element,
 };
 
 fn cpu() -> Backend {
@@ -40,6 +40,39 @@ fn kirsch_on_quads_and_mixed_cells_within_3_percent() {
             out.error, out.elements, out.wall_s
         );
         assert!(out.error <= kirsch::TOL, "{element:?}: error {}", out.error);
+    }
+}
+
+/// Scene 6: the geostatic stress is in equilibrium (regular and distorted quads, 2 %),
+/// every bench raises the cut floor further, and the soil yields by the last stage.
+#[test]
+fn slope_excavation_geostatic_within_2_percent_and_stages_heave() {
+    let cpu = cpu();
+    for distortion in [0.0, 0.1] {
+        let p = slope_excavation::Params {
+            distortion,
+            ..slope_excavation::Params::reduced()
+        };
+        let out = slope_excavation::run(&cpu, &p).unwrap();
+        eprintln!(
+            "slope (distortion {distortion}): error {:.3e}, heave {:?} m, yielded {:?}",
+            out.error,
+            out.stages.iter().map(|s| s.floor_heave).collect::<Vec<_>>(),
+            out.stages
+                .iter()
+                .map(|s| s.yielded_cells)
+                .collect::<Vec<_>>()
+        );
+        assert!(
+            out.error <= slope_excavation::TOL,
+            "{distortion}: {}",
+            out.error
+        );
+        assert_eq!(out.stages.len(), slope_excavation::STAGES);
+        for w in out.stages.windows(2) {
+            assert!(w[1].floor_heave > w[0].floor_heave && w[0].floor_heave > 0.0);
+        }
+        assert!(out.stages.last().unwrap().yielded_cells > 0);
     }
 }
 

@@ -328,7 +328,8 @@ impl Mechanics {
     fn element_dt(&self, e: usize, damped: bool) -> f64 {
         let m = self.model_of(e);
         let c = (m.wave_modulus() / m.density()).sqrt();
-        let h = self.geo.height[e] * shape_factor(self.geo.dim);
+        let share = self.mixed.as_ref().map_or(1.0, |mx| mx.dt_factor[e]);
+        let h = self.geo.height[e] * shape_factor(self.geo.dim) * share;
         if !damped || m.damp_factor() == 0.0 {
             return h / c;
         }
@@ -917,7 +918,12 @@ impl<D: Dim> Physics<D> for Mechanics {
             let mut c = [0.0; 3];
             for e in sel {
                 let e = e as usize;
-                mesh.element_centroid(e, &mut c[..D::D]);
+                // A Quad4/Hex8 cell starts from one stress, its centroid's.
+                if mesh.cells().is_empty() {
+                    mesh.element_centroid(e, &mut c[..D::D]);
+                } else {
+                    mesh.cell_centroid(mesh.cell_of(e), &mut c[..D::D]);
+                }
                 let s0 = field.at(&c, D::D);
                 if D::D == 2 {
                     st[3 * e..3 * e + 3].copy_from_slice(&[s0[0], s0[1], s0[3]]);
@@ -951,12 +957,18 @@ impl<D: Dim> Physics<D> for Mechanics {
             if null.is_some_and(|n| n[e] != 0.0) {
                 continue;
             }
-            let mut m = self.model_of(e).density() * self.geo.volume[e] / npe as f64;
+            let mut m = self.model_of(e).density() * self.geo.volume[e];
             if let Some(dt) = scale_to_dt {
                 let dte = self.element_dt(e, false);
                 m *= ((dt / dte) * (dt / dte)).max(0.0);
             }
-            for &n in conn {
+            // A mixed cell's simplices spread their mass over all the cell's nodes.
+            let nodes = match &self.mixed {
+                Some(mx) if mx.is_mixed(e) => mesh.cell_nodes(mesh.cell_of(e)),
+                _ => conn,
+            };
+            let m = m / nodes.len() as f64;
+            for &n in nodes {
                 mass[n as usize] += m;
             }
         }

@@ -22,6 +22,7 @@ pub mod kirsch;
 pub mod limits;
 pub mod platen_test;
 pub mod radial_flow;
+pub mod slope_excavation;
 pub mod triaxial;
 pub mod tunnel;
 pub mod ucs;
