@@ -4,9 +4,7 @@
 //! cells refused by name.
 
 use pcdc_compute::{Backend, Simulation, StaticOptions};
-use pcdc_mech::{
-    output, Boundary, Constraint, FaceStress, InitialStress, LinearElastic, Mechanics,
-};
+use pcdc_mech::{output, Boundary, Constraint, FaceStress, LinearElastic, Mechanics};
 use pcdc_mesh::{builders, Dim, Dim2, Dim3, ElementKind, Mesh, MeshError, Range};
 use proptest::prelude::*;
 
