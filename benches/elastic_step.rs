@@ -15,6 +15,12 @@
 //! `yielding` (confined at 10 MPa and loaded 1 % beyond the triaxial strength by the
 //! initial stress: every element returns to the surface every step, see `sim_mc`).
 //!
+//! Quad4/Hex8 rows (`quad4_*`, `hex8_*`): the same blocks meshed with Quad4 cells
+//! (two triangles each, the triangles of the `tri3` row) and Hex8 cells (five or six
+//! tetrahedra each) in the mixed discretisation (`pcdc_mech::mixed`: trace pass, element
+//! pass, pressure pass); throughput in cell-steps/s, so a Quad4 row divided by the
+//! `tri3` row's half gives the cost of the mixed passes.
+//!
 //! Run: `cargo bench --bench elastic_step`. Throughput is reported by criterion as
 //! elements/s (= element-steps/s).
 
@@ -116,7 +122,22 @@ fn bench(c: &mut Criterion) {
     let tri = builders::rectangle(0.0, 0.0, 0.05, 0.10, 0.05 / 224.0).unwrap();
     // 3D: cubes of 0.05/26 m, 6 tetrahedra each: 206 856 tetrahedra.
     let tet = builders::cuboid([0.0; 3], [0.05, 0.05, 0.0962], 0.05 / 26.0).unwrap();
+    // The same blocks in Quad4 (100 352 cells) and Hex8 (33 800 cells).
+    let quad = builders::rectangle_quads(0.0, 0.0, 0.05, 0.10, 0.05 / 224.0).unwrap();
+    let hex = builders::cuboid_hexes([0.0; 3], [0.05, 0.05, 0.0962], 0.05 / 26.0).unwrap();
     for &t in &threads {
+        let mut s = sim(quad.clone(), Backend::cpu(t).unwrap(), "bottom", "top");
+        g.throughput(Throughput::Elements(s.mesh().n_cells() as u64));
+        g.bench_function(
+            format!("quad4_{}k_cells_threads_{t}", s.mesh().n_cells() / 1000),
+            |b| b.iter(|| s.step().unwrap()),
+        );
+        let mut s = sim(hex.clone(), Backend::cpu(t).unwrap(), "zmin", "zmax");
+        g.throughput(Throughput::Elements(s.mesh().n_cells() as u64));
+        g.bench_function(
+            format!("hex8_{}k_cells_threads_{t}", s.mesh().n_cells() / 1000),
+            |b| b.iter(|| s.step().unwrap()),
+        );
         let mut s2 = sim(tri.clone(), Backend::cpu(t).unwrap(), "bottom", "top");
         g.throughput(Throughput::Elements(s2.mesh().n_elements() as u64));
         g.bench_function(
@@ -193,7 +214,7 @@ fn bench(c: &mut Criterion) {
             |b| b.iter(|| s2.run(GPU_STEPS).unwrap()),
         );
         g.throughput(Throughput::Elements(tet.n_elements() as u64 * GPU_STEPS));
-        let mut s3 = sim(tet.clone(), gpu, "zmin", "zmax");
+        let mut s3 = sim(tet.clone(), gpu.clone(), "zmin", "zmax");
         eprintln!(
             "{} {}: {:.0} bytes per element-step (Tet4)",
             name,
@@ -203,6 +224,18 @@ fn bench(c: &mut Criterion) {
         g.bench_function(
             format!("tet4_{}k_{name}_{}", tet.n_elements() / 1000, p.name()),
             |b| b.iter(|| s3.run(GPU_STEPS).unwrap()),
+        );
+        g.throughput(Throughput::Elements(quad.n_cells() as u64 * GPU_STEPS));
+        let mut q = sim(quad.clone(), gpu.clone(), "bottom", "top");
+        g.bench_function(
+            format!("quad4_{}k_cells_{name}_{}", quad.n_cells() / 1000, p.name()),
+            |b| b.iter(|| q.run(GPU_STEPS).unwrap()),
+        );
+        g.throughput(Throughput::Elements(hex.n_cells() as u64 * GPU_STEPS));
+        let mut h = sim(hex.clone(), gpu.clone(), "zmin", "zmax");
+        g.bench_function(
+            format!("hex8_{}k_cells_{name}_{}", hex.n_cells() / 1000, p.name()),
+            |b| b.iter(|| h.run(GPU_STEPS).unwrap()),
         );
     }
     g.finish();

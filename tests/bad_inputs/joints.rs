@@ -123,26 +123,3 @@ fn bad_joints_are_named_errors() {
         ],
     );
 }
-
-/// The null model does not yet reach joints: excavating in a jointed scene is refused
-/// with the reason, not run with joints to null elements still holding.
-#[test]
-fn null_model_in_a_jointed_scene_is_refused() {
-    use pcdc::compute::{Backend, Simulation};
-    use pcdc_cohesive::CohesiveJoints;
-    use pcdc_mech::{set_null, LinearElastic, Mechanics};
-    use pcdc_mesh::{builders, split_nodes, Range};
-    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.25).unwrap();
-    let split = split_nodes(&mesh, &Range::All).unwrap();
-    let rock = LinearElastic::new(1e9, 0.25, 2000.0).unwrap();
-    let mut sim = Simulation::builder(split, Backend::cpu(1).unwrap())
-        .physics(Mechanics::new().material(Range::All, rock))
-        .physics(CohesiveJoints::new().model(Range::All, czm(1e6, 2e6, 1.0, 30.0, 1e12).unwrap()))
-        .build()
-        .unwrap();
-    let err = set_null(&mut sim, &Range::All).unwrap_err().to_string();
-    assert!(
-        err.contains("cohesive joints") && err.contains("null"),
-        "{err}"
-    );
-}

@@ -702,12 +702,23 @@ impl<D: Dim> Physics<D> for CohesiveJoints {
         Ok(())
     }
 
-    fn stable_step(&self, kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
+    fn stable_step(&self, kin: &Kinematics<'_, D>, fields: &FieldStore) -> Option<StableStep> {
         let npf = D::NODES_PER_FACE;
         let mut best: Option<(f64, usize)> = None;
         let mut mid = [0.0; 9];
         let mut n = [0.0; 3];
+        // A joint to a null element (the null model) is a free face: no stiffness.
+        let null = fields
+            .id(pcdc_compute::names::ELEMENT_NULL)
+            .ok()
+            .map(|id| fields.get(id));
+        let elements = self.joints.elements();
         for j in 0..self.joints.len() {
+            if null.is_some_and(|z| {
+                z[elements[2 * j] as usize] != 0.0 || z[elements[2 * j + 1] as usize] != 0.0
+            }) {
+                continue;
+            }
             let nodes = self.joints.joint_nodes(j);
             for k in 0..npf {
                 mid[k * D::D..(k + 1) * D::D].copy_from_slice(kin.mesh.node(nodes[k] as usize));

@@ -22,6 +22,8 @@ const SCAN_BLOCK: usize = 64;
 pub(crate) struct ActiveSet {
     /// The broken faces (sorted) the flags were derived from; `None` before the first step.
     seen: Option<Vec<u32>>,
+    /// The null elements (sorted) the flags were derived from.
+    seen_null: Vec<u32>,
     /// Per element: sealed (nothing can touch it).
     pub sealed: Vec<bool>,
     /// The nodes of the unsealed elements, sorted and unique.
@@ -34,13 +36,17 @@ impl ActiveSet {
     /// sealed. Bonds only break, but a restored snapshot may change them any way, so the
     /// whole set of broken faces is compared, not a count. Returns whether the set was
     /// re-derived (always on the first call).
+    /// A null element (`null[e] != 0`, the null model of excavation) is sealed too.
     pub fn refresh<D: Dim>(
         &mut self,
         regions: Option<&mut BondedRegions>,
         broken: &[f64],
+        null: &[f64],
         mesh: &Mesh<D>,
     ) -> bool {
-        if self.seen.as_deref().is_some_and(|s| same_broken(s, broken)) {
+        if self.seen.as_deref().is_some_and(|s| same_broken(s, broken))
+            && same_broken(&self.seen_null, null)
+        {
             return false;
         }
         let ne = mesh.n_elements();
@@ -60,6 +66,10 @@ impl ActiveSet {
                 self.sealed.resize(ne, false);
             }
         }
+        for (e, s) in self.sealed.iter_mut().enumerate() {
+            *s |= null.get(e).is_some_and(|&v| v != 0.0);
+        }
+        self.seen_null = broken_faces(null);
         self.nodes.clear();
         for e in (0..ne).filter(|&e| !self.sealed[e]) {
             self.nodes.extend_from_slice(mesh.element(e));

@@ -187,6 +187,11 @@ pub(crate) fn setup<D: Dim>(
         GpuData::U32(input.regions.map_or(vec![0], |r| r.elem_vertex.clone())),
     );
     let vertex_flags = setup.upload("vertex flags", GpuData::U32(vec![0; nv.max(1)]));
+    // The null model's flags (declared by the mechanics), or zeros without it.
+    let element_null = match setup.field(pcdc_compute::names::ELEMENT_NULL) {
+        Ok(b) => b,
+        Err(_) => setup.upload("no null elements", GpuData::Real(vec![0.0; ne.max(1)])),
+    };
     let overflow = setup.error(move |e| crate::physics::overflow_message(e, capacity));
     let tiny = match setup.precision() {
         Precision::F64 => f64::MIN_POSITIVE,
@@ -312,6 +317,7 @@ pub(crate) fn setup<D: Dim>(
             .bind("model_data", model_data, Access::Read)
             .bind("elem_vertex", elem_vertex, Access::Read)
             .bind("vertex_flags", vertex_flags, Access::Read)
+            .bind("element_null", element_null, Access::Read)
             .bind("slots", setup.slots(), Access::ReadWrite),
     ];
     if let Some(r) = input.regions.filter(|_| regions) {

@@ -597,7 +597,8 @@ impl Contact {
         }
         let (mut best, mut which) = (f64::INFINITY, 0);
         for (n, (&m, &kn)) in kin.mass.iter().zip(&k).enumerate() {
-            if kn > 0.0 {
+            // A node without mass dropped out with its null elements: contact skips it.
+            if kn > 0.0 && m > 0.0 {
                 let dt = 2.0 * (m / (2.0 * kn)).sqrt();
                 if dt < best {
                     best = dt;
@@ -1153,6 +1154,10 @@ impl<D: Dim> Physics<D> for Contact {
         let k = (3.0 * penalty).max(shear);
         let (mut best, mut which) = (f64::INFINITY, 0);
         for (n, &m) in kin.mass.iter().enumerate() {
+            // A node without mass dropped out with its null elements: contact skips it.
+            if m == 0.0 {
+                continue;
+            }
             let dt = 2.0 * (m / (2.0 * k)).sqrt();
             if dt < best {
                 best = dt;
@@ -1173,11 +1178,16 @@ impl<D: Dim> Physics<D> for Contact {
         // Where contact can happen this step (see the `exclusion` and `active` modules).
         let broken_id = self.bonds.as_ref().and_then(|b| b.id);
         let broken: &[f64] = broken_id.map_or(&[], |b| ctx.fields.get(b));
+        // Null elements (excavated by the null model) are sealed.
+        let null: &[f64] = ctx
+            .fields
+            .id(pcdc_compute::names::ELEMENT_NULL)
+            .map_or(&[], |id| ctx.fields.get(id));
         let active = &mut self.active;
         let regions = self.regions.as_mut();
         let refreshed = ctx
             .backend
-            .install(|| active.refresh(regions, broken, kin.mesh));
+            .install(|| active.refresh(regions, broken, null, kin.mesh));
         // Rebuild when a node of an unsealed element moved more than half the skin since
         // the last build (a NaN reference, before the first build, always does).
         let limit2 = (0.5 * self.skin_used).powi(2);

@@ -98,22 +98,12 @@ pub fn reset_element_state<D: Dim>(
 /// from the missing internal forces, as in an excavation. Returns the number of
 /// elements switched (already null ones included).
 ///
-/// Joints and contact do not yet know null elements, so a simulation that has either
-/// (a physics named "cohesive joints" or "contact") is refused rather than run with
-/// joints to excavated elements still holding.
+/// Joints to a null element become free faces: the damage of every interface with a
+/// null side is set to 1 (`names::JOINT_DAMAGE`, when a joint physics declares it), so
+/// the joint transfers no force from then on and its faces count as broken; contact
+/// treats null elements as sealed (it reads `element_null` on both backends), so
+/// nothing touches them.
 pub fn set_null<D: Dim>(sim: &mut Simulation<D>, range: &Range) -> Result<usize, MechError> {
-    if let Some(p) = sim
-        .physics_names()
-        .into_iter()
-        .find(|n| n.contains("joint") || n.contains("contact"))
-    {
-        return Err(MechError::param(
-            "null model",
-            p,
-            "is composed: joints and contact do not yet skip null elements, so excavation \
-             is limited to continuum scenes",
-        ));
-    }
     let elems = sim.mesh().select_elements(range)?;
     let id = sim.state.fields.id(names::ELEMENT_NULL)?;
     let null = sim.state.fields.get_mut(id);
@@ -126,6 +116,21 @@ pub fn set_null<D: Dim>(sim: &mut Simulation<D>, range: &Range) -> Result<usize,
     let s = sim.state.fields.get_mut(strain);
     for &e in &elems {
         s[e as usize * nsym..(e as usize + 1) * nsym].fill(0.0);
+    }
+    if let Ok(id) = sim.state.fields.id(names::JOINT_DAMAGE) {
+        let mut is_null = vec![false; sim.mesh().n_elements()];
+        for &e in &elems {
+            is_null[e as usize] = true;
+        }
+        let sides: Vec<bool> = (sim.mesh().interfaces().elements().chunks_exact(2))
+            .map(|p| is_null[p[0] as usize] || is_null[p[1] as usize])
+            .collect();
+        let damage = sim.state.fields.get_mut(id);
+        for (j, &hit) in sides.iter().enumerate() {
+            if hit && j < damage.len() {
+                damage[j] = 1.0;
+            }
+        }
     }
     sim.refresh_mass()?;
     Ok(elems.len())

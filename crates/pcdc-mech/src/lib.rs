@@ -31,6 +31,7 @@
 //! | eq. 34–48 (47–48 \[CORRECTED\]), table 3 | Burgers creep in deviatoric tensor form, Crank–Nicolson, with a creep clock and creep steps relaxed to equilibrium | [`Burgers`], [`CreepClock`], [`creep_step`], [`burgers`] |
 //! | 7.2.8 | null model (excavation: no stiffness, mass, gravity or stress; nodes without a live element drop out), stage resets, geostatic initial stress (K0, depth gradient, principal values at an angle) | [`set_null`], [`reset_velocity`], [`reset_displacement`], [`reset_element_state`], [`InitialStress`] |
 //! | tables 4–7 | velocity/acceleration, force, face stress, move constraints | [`Boundary`] |
+//! | chapter 4 (element types) | Quad4/Hex8 cells, also mixed with Tri3/Tet4: Marti–Cundall mixed discretisation over the cell's simplices (cell-mean volumetric strain and pressure, B̄ stiffness, mass lumped equally on the cell's nodes) \[NOT IN MANUAL: the manual does not say how its quadrilaterals are integrated\] | [`mixed`] |
 //!
 //! The stable step of an element is `κ h / c_p` with h its smallest height, c_p the
 //! P-wave speed and κ = 0.8 (Tri3) or 0.45 (Tet4) from the element eigenvalues; with

@@ -2,7 +2,8 @@
 //!
 //! Struct-of-arrays meshes for the pcdc-rs FDEM SDK (manual chapter 4): dimension types
 //! ([`Dim2`], [`Dim3`]), the [`Mesh`] of Tri3 or Tet4 elements with its faces and
-//! groups, [`Range`] selections, checks on build, specimen builders, Gmsh MSH 4.1 import
+//! groups (and, for meshes of Quad4/Hex8 cells mixed freely with simplices, the
+//! [`Cells`] table of the simplices each cell is cut into, see [`cells`]), [`Range`] selections, checks on build, specimen builders, Gmsh MSH 4.1 import
 //! and VTU/PVD output for ParaView; node splitting into FDEM regions ([`split_nodes`])
 //! and the [`Interfaces`] (face-joints, matched node pairs, master-node map) a split
 //! mesh carries for every physics to read.

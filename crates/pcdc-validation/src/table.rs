@@ -17,7 +17,7 @@ use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
     block_sliding, brazilian, creep, direct_tension, fracture_flow, injection, kirsch, radial_flow,
-    triaxial, tunnel, ucs, unconfined_flow, vibration_energy, wave_speed,
+    slope_excavation, triaxial, tunnel, ucs, unconfined_flow, vibration_energy, wave_speed,
 };
 
 /// One measured row of the report.
@@ -128,6 +128,7 @@ pub const CASES: &[&str] = &[
     "triaxial",
     "creep",
     "tunnel",
+    "slope_excavation",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -146,8 +147,8 @@ impl Job {
     /// wave and vibration scenes use 2 and 2.5 times the 2D size.
     pub fn mesh_size(&self) -> f64 {
         match (self.case, self.variant) {
-            ("wave_speed", "3d") => 2.0 * self.size,
-            ("vibration_energy", "3d") => 2.5 * self.size,
+            ("wave_speed", "3d" | "3d hex8") => 2.0 * self.size,
+            ("vibration_energy", "3d" | "3d hex8") => 2.5 * self.size,
             ("fracture_flow", "3d") => 2.0 * self.size,
             _ => self.size,
         }
@@ -177,6 +178,32 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 }
                 out.push(j("kirsch", "relaxation", size));
             }
+            // Quad4 and Tri3/Quad4 cells: the polar grid is uniform in angle, so it has
+            // about three times the triangles' elements at a given size at the hole.
+            for size in [0.05, 0.035, kirsch_full] {
+                for cells in ["quad4", "mixed"] {
+                    if !gpu {
+                        out.push(j(
+                            "kirsch",
+                            if cells == "quad4" {
+                                "direct quad4"
+                            } else {
+                                "direct mixed"
+                            },
+                            size,
+                        ));
+                    }
+                    out.push(j(
+                        "kirsch",
+                        if cells == "quad4" {
+                            "relaxation quad4"
+                        } else {
+                            "relaxation mixed"
+                        },
+                        size,
+                    ));
+                }
+            }
         }
         "wave_speed" | "vibration_energy" => {
             let (name, s) = if case == "wave_speed" {
@@ -187,6 +214,7 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
             for size in [4.0 * s, 2.0 * s, s] {
                 out.push(j(name, "2d", size));
                 out.push(j(name, "3d", size));
+                out.push(j(name, "3d hex8", size));
             }
         }
         "block_sliding" => {
@@ -239,6 +267,12 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("tunnel", "Salençon", size));
             }
         }
+        "slope_excavation" => {
+            for size in [2.5, 1.5, slope_excavation::Params::full().size] {
+                out.push(j("slope_excavation", "geostatic, regular", size));
+                out.push(j("slope_excavation", "geostatic, distorted 10 %", size));
+            }
+        }
         // Homogeneous blocks: the mesh changes the cost, not the closed form.
         "creep" => {
             for size in [0.05, 0.025, 0.0125] {
@@ -284,13 +318,21 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
         |elements, error: f64, tol: f64, steps| row(elements, error, pct(tol), error <= tol, steps);
     Ok(match job.case {
         "kirsch" => {
-            let solver = if job.variant == "direct" {
+            let solver = if job.variant.starts_with("direct") {
                 kirsch::Solver::Direct
             } else {
                 kirsch::Solver::Relaxation
             };
+            let element = if job.variant.ends_with("quad4") {
+                crate::scenes::Element::Quad4
+            } else if job.variant.ends_with("mixed") {
+                crate::scenes::Element::Mixed
+            } else {
+                crate::scenes::Element::Simplex
+            };
             let p = kirsch::Params {
                 size_at_hole: job.size,
+                element,
                 ..kirsch::Params::full()
             };
             let o = kirsch::run(backend, &p, solver)?;
@@ -354,10 +396,10 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
         }
         "wave_speed" => {
             let p = wave_speed::Params { size: job.size };
-            let o = if job.variant == "2d" {
-                wave_speed::run_2d(backend, &p)?
-            } else {
-                wave_speed::run_3d(backend, &p)?
+            let o = match job.variant {
+                "2d" => wave_speed::run_2d(backend, &p)?,
+                "3d hex8" => wave_speed::run_3d_hex8(backend, &p)?,
+                _ => wave_speed::run_3d(backend, &p)?,
             };
             within(o.elements, o.error, wave_speed::TOL, o.steps)
         }
@@ -366,12 +408,25 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
                 size: job.size,
                 ..vibration_energy::Params::full()
             };
-            let o = if job.variant == "2d" {
-                vibration_energy::run_2d(backend, &p)?
-            } else {
-                vibration_energy::run_3d(backend, &p)?
+            let o = match job.variant {
+                "2d" => vibration_energy::run_2d(backend, &p)?,
+                "3d hex8" => vibration_energy::run_3d_hex8(backend, &p)?,
+                _ => vibration_energy::run_3d(backend, &p)?,
             };
             within(o.elements, o.drift, vibration_energy::TOL, o.steps)
+        }
+        "slope_excavation" => {
+            let p = slope_excavation::Params {
+                size: job.size,
+                vtu_dir: None,
+                distortion: if job.variant.contains("distorted") {
+                    0.1
+                } else {
+                    0.0
+                },
+            };
+            let o = slope_excavation::run(backend, &p)?;
+            within(2 * o.cells, o.error, slope_excavation::TOL, o.steps)
         }
         "tunnel" => {
             let p = tunnel::Params {
@@ -704,6 +759,6 @@ mod tests {
         }
         assert!(jobs("kirsch", true)
             .iter()
-            .all(|j| j.variant == "relaxation"));
+            .all(|j| j.variant.starts_with("relaxation")));
     }
 }

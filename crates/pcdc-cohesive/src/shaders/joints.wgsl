@@ -56,6 +56,10 @@ fn kernel(j: u32) {
         for (var i = 0u; i < 2u * NPF * D; i = i + 1u) {
             slots[s0 + i] = Real(0.0);
         }
+        // As on the CPU, a joint whose damage reached 1 in any way (its law, or the null
+        // model breaking it from the host) flags its faces.
+        broken_face[joint_info[r + 2u * NPF]] = 1.0;
+        broken_face[joint_info[r + 2u * NPF + 1u]] = 1.0;
         return;
     }
     let kind = joint_info[r + 2u * NPF + 2u];

@@ -1,7 +1,11 @@
 // Where contact can happen (the CPU's `exclusion` module): a sealed element (every
-// vertex closed) and a pair sharing an intact vertex are skipped. REGIONS = 0 when no
+// vertex closed, or the element null) and a pair sharing an intact vertex are skipped. REGIONS = 0 when no
 // bonds are declared (nothing skipped; the buffers are placeholders).
 fn sealed(e: u32) -> bool {
+    // A null element (excavated, manual 7.2.8) touches nothing.
+    if element_null[e] != 0.0 {
+        return true;
+    }
     if REGIONS == 0u {
         return false;
     }
