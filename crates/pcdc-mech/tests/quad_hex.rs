@@ -319,6 +319,11 @@ fn cell_meshes_round_trip_through_serde() {
         .unwrap()
         .to_string();
     assert!(e.contains("first_element"), "{e}");
+    // A split cell mesh (cells renumbered, interfaces on cell faces) reads back too.
+    let split = pcdc_mesh::split_nodes(&m, &Range::All).unwrap();
+    let back: Mesh<Dim3> = serde_json::from_str(&serde_json::to_string(&split).unwrap()).unwrap();
+    assert_eq!(back.cells(), split.cells());
+    assert_eq!(back.interfaces().len(), split.interfaces().len());
 }
 
 /// The FDEM node split keeps each Quad4/Hex8 cell whole: joints on the cell faces only
@@ -481,4 +486,29 @@ fn nalgebra_free_inverse(a: &[f64]) -> [f64; 9] {
         (a[1] * a[6] - a[0] * a[7]) / det,
         (a[0] * a[4] - a[1] * a[3]) / det,
     ]
+}
+
+/// Tet4 and Hex8 cells in one mesh: every other hexahedron of a block listed as the
+/// Tet4 cells it is cut into conforms with the Hex8 cells around it, and the patch test
+/// holds on the distorted mixed mesh.
+#[test]
+fn tet4_and_hex8_in_one_mesh_pass_the_patch_test() {
+    let hexes = builders::cuboid_hexes([0.0; 3], [1.0; 3], 0.34).unwrap();
+    let (mut kinds, mut conn) = (Vec::new(), Vec::new());
+    for c in 0..hexes.n_cells() {
+        if c % 2 == 0 {
+            kinds.push(ElementKind::Hex8);
+            conn.extend_from_slice(hexes.cell_nodes(c));
+        } else {
+            for e in hexes.cell_elements(c) {
+                kinds.push(ElementKind::Tet4);
+                conn.extend_from_slice(hexes.element(e));
+            }
+        }
+    }
+    let mixed = Mesh::<Dim3>::from_cells(hexes.coords().to_vec(), kinds, conn).unwrap();
+    assert_eq!(mixed.n_elements(), hexes.n_elements());
+    assert_eq!(mixed.faces().boundary.len(), hexes.faces().boundary.len());
+    let a = [3e-4, -1e-4, 2e-4, 5e-5, -2e-4, 1e-4, -3e-5, 2e-4, -1e-4];
+    patch(distorted(&mixed, 11, 0.1), &a, 0.3).unwrap();
 }
