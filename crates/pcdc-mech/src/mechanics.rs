@@ -1301,9 +1301,12 @@ impl<D: Dim> Physics<D> for Mechanics {
         setup.kernel(Phase::Forces, kernel)?;
         if mixed {
             let body = if d == 2 {
-                include_str!("shaders/mixed_pressure_2d.wgsl")
+                format!(
+                    "{mixed_lib}{}",
+                    include_str!("shaders/mixed_pressure_2d.wgsl")
+                )
             } else {
-                include_str!("shaders/mixed_pressure_3d.wgsl")
+                include_str!("shaders/mixed_pressure_3d.wgsl").to_string()
             };
             let pressure = Kernel::new(format!("mechanics mixed pressure {}", D::NAME), body, ne)
                 .const_u32("SLOT_FIRST", setup.slot_first())

@@ -439,3 +439,30 @@ pub(crate) fn add_hooke(lambda: f64, two_mu: f64, e: &Sym6, stress: &mut Sym6) {
 pub fn double_dot(a: &Sym6, b: &Sym6) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + 2.0 * (a[3] * b[3] + a[4] * b[4] + a[5] * b[5])
 }
+
+/// The [`ConstitutiveModel`] methods that a model built on a [`LinearElastic`] field takes
+/// from it unchanged: density, Young's modulus, wave modulus, damping factor and the
+/// contact surface properties (used by Mohr–Coulomb and Burgers).
+macro_rules! delegate_elastic {
+    ($field:ident) => {
+        fn density(&self) -> f64 {
+            self.$field.density()
+        }
+        fn young(&self) -> f64 {
+            self.$field.young()
+        }
+        fn wave_modulus(&self) -> f64 {
+            $crate::model::ConstitutiveModel::wave_modulus(&self.$field)
+        }
+        fn damp_factor(&self) -> f64 {
+            self.$field.damp_factor()
+        }
+        fn contact_friction(&self) -> f64 {
+            self.$field.friction()
+        }
+        fn contact_penalty(&self) -> f64 {
+            self.$field.contact_penalty()
+        }
+    };
+}
+pub(crate) use delegate_elastic;

@@ -687,24 +687,7 @@ impl ConstitutiveModel for MohrCoulomb {
     fn name(&self) -> &str {
         "mech-mohr-coulomb"
     }
-    fn density(&self) -> f64 {
-        self.elastic.density()
-    }
-    fn young(&self) -> f64 {
-        self.elastic.young()
-    }
-    fn wave_modulus(&self) -> f64 {
-        ConstitutiveModel::wave_modulus(&self.elastic)
-    }
-    fn damp_factor(&self) -> f64 {
-        self.elastic.damp_factor()
-    }
-    fn contact_friction(&self) -> f64 {
-        self.elastic.friction()
-    }
-    fn contact_penalty(&self) -> f64 {
-        self.elastic.contact_penalty()
-    }
+    crate::model::delegate_elastic!(elastic);
     fn n_state(&self) -> usize {
         MC_STATE
     }

@@ -397,7 +397,10 @@ fn mixed_forces_are_conjugate_to_the_mixed_strain() {
                 h
             } else {
                 let m: Vec<f64> = (0..9).map(|k| dm(k / 3, k % 3)).collect();
-                let mm = nalgebra_free_inverse(&m);
+                // (D_m⁻¹)[a][j] = (D_m⁻ᵀ)[j][a], from the kinematics' own inverse-transpose.
+                let m: [f64; 9] = m.try_into().unwrap();
+                let it = pcdc_mech::kinematics::inv_transpose3(&m);
+                let mm: Vec<f64> = (0..9).map(|k| it[3 * (k % 3) + k / 3]).collect();
                 let mut h = [[0.0; 3]; 3];
                 for i in 0..3 {
                     let dd = |a: usize| du[conn[a] as usize * 3 + i] - du[conn[0] as usize * 3 + i];
@@ -469,23 +472,6 @@ fn mixed_forces_are_conjugate_to_the_mixed_strain() {
         5,
         0.1,
     ));
-}
-
-/// Inverse of a row-major 3x3 matrix (cofactors).
-fn nalgebra_free_inverse(a: &[f64]) -> [f64; 9] {
-    let det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
-        + a[2] * (a[3] * a[7] - a[4] * a[6]);
-    [
-        (a[4] * a[8] - a[5] * a[7]) / det,
-        (a[2] * a[7] - a[1] * a[8]) / det,
-        (a[1] * a[5] - a[2] * a[4]) / det,
-        (a[5] * a[6] - a[3] * a[8]) / det,
-        (a[0] * a[8] - a[2] * a[6]) / det,
-        (a[2] * a[3] - a[0] * a[5]) / det,
-        (a[3] * a[7] - a[4] * a[6]) / det,
-        (a[1] * a[6] - a[0] * a[7]) / det,
-        (a[0] * a[4] - a[1] * a[3]) / det,
-    ]
 }
 
 /// Tet4 and Hex8 cells in one mesh: every other hexahedron of a block listed as the

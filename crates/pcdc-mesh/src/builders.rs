@@ -773,36 +773,8 @@ pub fn dog_bone(
 /// Groups (nodes and boundary faces): `"xmin"`, `"xmax"`, `"ymin"`, `"ymax"`, `"zmin"`,
 /// `"zmax"`; elements: `"all"`.
 pub fn cuboid(origin: [f64; 3], size_xyz: [f64; 3], size: f64) -> Result<Mesh<Dim3>, MeshError> {
-    for (k, name) in ["origin[0]", "origin[1]", "origin[2]"]
-        .into_iter()
-        .enumerate()
-    {
-        finite(name, origin[k])?;
-    }
-    for (k, name) in ["size_xyz[0]", "size_xyz[1]", "size_xyz[2]"]
-        .into_iter()
-        .enumerate()
-    {
-        positive(name, size_xyz[k])?;
-    }
-    positive("size", size)?;
-    let largest = size_xyz.iter().copied().fold(0.0, f64::max);
-    at_most("size", size, largest, "must not exceed the largest side")?;
-    let nf = size_xyz.map(|l| (l / size).ceil());
-    check_count::<Dim3>("size", size, 6.0 * nf[0] * nf[1] * nf[2])?;
-    let n = nf.map(|v| v as usize);
-    let idx = |i: usize, j: usize, k: usize| ((k * (n[1] + 1) + j) * (n[0] + 1) + i) as u32;
-
-    let mut coords = Vec::with_capacity(3 * (n[0] + 1) * (n[1] + 1) * (n[2] + 1));
-    for k in 0..=n[2] {
-        for j in 0..=n[1] {
-            for i in 0..=n[0] {
-                let f = [i, j, k];
-                coords
-                    .extend((0..3).map(|a| origin[a] + size_xyz[a] * (f[a] as f64 / n[a] as f64)));
-            }
-        }
-    }
+    let grid = CuboidGrid::new(origin, size_xyz, size, 6.0)?;
+    let (n, idx) = (grid.n, |i, j, k| grid.idx(i, j, k));
     // Kuhn tetrahedra: paths 000 -> e_p0 -> e_p0 + e_p1 -> 111 for each permutation p of the
     // axes; the signed volume has the sign of the permutation, so odd ones swap two nodes.
     const PERMS: [([usize; 3], bool); 6] = [
@@ -832,28 +804,88 @@ pub fn cuboid(origin: [f64; 3], size_xyz: [f64; 3], size: f64) -> Result<Mesh<Di
             }
         }
     }
-    let face = |axis: usize, at: usize| {
-        let mut nodes = Vec::new();
+    let boundaries = grid.boundaries();
+    finish(grid.coords, tets, boundaries)
+}
+
+/// The checked parameters, node grid and boundary groups of a [`cuboid`] or
+/// [`cuboid_hexes`]: `n[k]` cells along axis k, nodes numbered x fastest.
+struct CuboidGrid {
+    n: [usize; 3],
+    coords: Vec<f64>,
+}
+
+impl CuboidGrid {
+    /// Checks the parameters (with `per_cell` elements per cell for the size guard) and
+    /// lays out the nodes.
+    fn new(
+        origin: [f64; 3],
+        size_xyz: [f64; 3],
+        size: f64,
+        per_cell: f64,
+    ) -> Result<Self, MeshError> {
+        for (k, name) in ["origin[0]", "origin[1]", "origin[2]"]
+            .into_iter()
+            .enumerate()
+        {
+            finite(name, origin[k])?;
+        }
+        for (k, name) in ["size_xyz[0]", "size_xyz[1]", "size_xyz[2]"]
+            .into_iter()
+            .enumerate()
+        {
+            positive(name, size_xyz[k])?;
+        }
+        positive("size", size)?;
+        let largest = size_xyz.iter().copied().fold(0.0, f64::max);
+        at_most("size", size, largest, "must not exceed the largest side")?;
+        let nf = size_xyz.map(|l| (l / size).ceil());
+        check_count::<Dim3>("size", size, per_cell * nf[0] * nf[1] * nf[2])?;
+        let n = nf.map(|v| v as usize);
+        let mut coords = Vec::with_capacity(3 * (n[0] + 1) * (n[1] + 1) * (n[2] + 1));
         for k in 0..=n[2] {
             for j in 0..=n[1] {
                 for i in 0..=n[0] {
-                    if [i, j, k][axis] == at {
-                        nodes.push(idx(i, j, k));
-                    }
+                    let f = [i, j, k];
+                    coords.extend(
+                        (0..3).map(|a| origin[a] + size_xyz[a] * (f[a] as f64 / n[a] as f64)),
+                    );
                 }
             }
         }
-        nodes
-    };
-    let boundaries = vec![
-        ("xmin", face(0, 0)),
-        ("xmax", face(0, n[0])),
-        ("ymin", face(1, 0)),
-        ("ymax", face(1, n[1])),
-        ("zmin", face(2, 0)),
-        ("zmax", face(2, n[2])),
-    ];
-    finish(coords, tets, boundaries)
+        Ok(CuboidGrid { n, coords })
+    }
+
+    /// Index of grid node (i, j, k).
+    fn idx(&self, i: usize, j: usize, k: usize) -> u32 {
+        ((k * (self.n[1] + 1) + j) * (self.n[0] + 1) + i) as u32
+    }
+
+    /// The node groups of the six faces.
+    fn boundaries(&self) -> Vec<Boundary> {
+        let n = self.n;
+        let face = |axis: usize, at: usize| {
+            let mut nodes = Vec::new();
+            for k in 0..=n[2] {
+                for j in 0..=n[1] {
+                    for i in 0..=n[0] {
+                        if [i, j, k][axis] == at {
+                            nodes.push(self.idx(i, j, k));
+                        }
+                    }
+                }
+            }
+            nodes
+        };
+        vec![
+            ("xmin", face(0, 0)),
+            ("xmax", face(0, n[0])),
+            ("ymin", face(1, 0)),
+            ("ymax", face(1, n[1])),
+            ("zmin", face(2, 0)),
+            ("zmax", face(2, n[2])),
+        ]
+    }
 }
 
 /// Cylinder of radius `radius` (m) around the z axis, from `z = 0` to `z = height` (m): the

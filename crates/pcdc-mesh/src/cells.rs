@@ -71,19 +71,9 @@ impl Cells {
         self.first_element[c] as usize..self.first_element[c + 1] as usize
     }
 
-    /// First element of every cell and, last, the element count (`len() + 1` values).
-    pub fn first_elements(&self) -> &[u32] {
-        &self.first_element
-    }
-
     /// The cell element `e` belongs to.
     pub fn cell_of(&self, e: usize) -> usize {
         self.cell_of[e] as usize
-    }
-
-    /// Cell of every element.
-    pub fn cell_of_elements(&self) -> &[u32] {
-        &self.cell_of
     }
 
     /// Whether some cell is cut into more than one simplex (a Quad4 or Hex8).

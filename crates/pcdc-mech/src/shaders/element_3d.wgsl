@@ -58,6 +58,24 @@ fn polar_3d(f: M3, r_prev: M3) -> M3 {
     return mul3(r_prev, x);
 }
 
+// F = I + [u_j − u₀] D_m⁻¹ of element e, from displacement differences (they keep small
+// strains), as `Mechanics::deformation_gradient_3d` on the CPU.
+fn deformation_gradient(e: u32, mm: M3) -> M3 {
+    let o0 = conn[4u * e] * 3u;
+    var du: M3;
+    for (var i = 0u; i < 3u; i = i + 1u) {
+        let o = disp[o0 + i];
+        for (var j = 0u; j < 3u; j = j + 1u) {
+            du[3u * i + j] = disp[conn[4u * e + j + 1u] * 3u + i] - o;
+        }
+    }
+    var f = mul3(du, mm);
+    f[0] = f[0] + 1.0;
+    f[4] = f[4] + 1.0;
+    f[8] = f[8] + 1.0;
+    return f;
+}
+
 fn kernel(e: u32) {
     // A null element carries no force (manual 7.2.8).
     if element_null[e] != 0.0 {
@@ -78,18 +96,7 @@ fn kernel(e: u32) {
     }
     let vol = geo[g + 9u];
     let cv = geo[g + 10u];
-    // F = I + H, H = [u_j − u₀] D_m⁻¹ (displacement differences keep small strains).
-    var du: M3;
-    for (var i = 0u; i < 3u; i = i + 1u) {
-        let o = disp[n[0] + i];
-        for (var j = 0u; j < 3u; j = j + 1u) {
-            du[3u * i + j] = disp[n[j + 1u] + i] - o;
-        }
-    }
-    var f = mul3(du, mm);
-    f[0] = f[0] + 1.0;
-    f[4] = f[4] + 1.0;
-    f[8] = f[8] + 1.0;
+    let f = deformation_gradient(e, mm);
     var r_prev: M3;
     for (var k = 0u; k < 9u; k = k + 1u) {
         r_prev[k] = rotation[9u * e + k];

@@ -16,17 +16,11 @@ fn kernel(e: u32) {
     }
     let g = e * GEO;
     let dp = (pbar - in_plane_mean(e)) * geo[g + 4u];
-    let n0 = conn[3u * e] * 2u;
-    let n1 = conn[3u * e + 1u] * 2u;
-    let n2 = conn[3u * e + 2u] * 2u;
-    let d0 = disp[n1] - disp[n0];
-    let d1 = disp[n2] - disp[n0];
-    let d2 = disp[n1 + 1u] - disp[n0 + 1u];
-    let d3 = disp[n2 + 1u] - disp[n0 + 1u];
-    let h0 = d0 * geo[g] + d1 * geo[g + 2u];
-    let h1 = d0 * geo[g + 1u] + d1 * geo[g + 3u];
-    let h2 = d2 * geo[g] + d3 * geo[g + 2u];
-    let h3 = d2 * geo[g + 1u] + d3 * geo[g + 3u];
+    let h = disp_gradient_2d(e);
+    let h0 = h[0];
+    let h1 = h[1];
+    let h2 = h[2];
+    let h3 = h[3];
     // The rotation as the element pass finds it.
     let pc = 2.0 + (h0 + h3);
     let ps = h2 - h1;

@@ -82,35 +82,8 @@ pub fn cuboid_hexes(
     size_xyz: [f64; 3],
     size: f64,
 ) -> Result<Mesh<Dim3>, MeshError> {
-    for (k, name) in ["origin[0]", "origin[1]", "origin[2]"]
-        .into_iter()
-        .enumerate()
-    {
-        finite(name, origin[k])?;
-    }
-    for (k, name) in ["size_xyz[0]", "size_xyz[1]", "size_xyz[2]"]
-        .into_iter()
-        .enumerate()
-    {
-        positive(name, size_xyz[k])?;
-    }
-    positive("size", size)?;
-    let largest = size_xyz.iter().copied().fold(0.0, f64::max);
-    at_most("size", size, largest, "must not exceed the largest side")?;
-    let nf = size_xyz.map(|l| (l / size).ceil());
-    check_count::<Dim3>("size", size, 6.0 * nf[0] * nf[1] * nf[2])?;
-    let n = nf.map(|v| v as usize);
-    let idx = |i: usize, j: usize, k: usize| ((k * (n[1] + 1) + j) * (n[0] + 1) + i) as u32;
-    let mut coords = Vec::with_capacity(3 * (n[0] + 1) * (n[1] + 1) * (n[2] + 1));
-    for k in 0..=n[2] {
-        for j in 0..=n[1] {
-            for i in 0..=n[0] {
-                let f = [i, j, k];
-                coords
-                    .extend((0..3).map(|a| origin[a] + size_xyz[a] * (f[a] as f64 / n[a] as f64)));
-            }
-        }
-    }
+    let grid = super::CuboidGrid::new(origin, size_xyz, size, 6.0)?;
+    let (n, idx) = (grid.n, |i, j, k| grid.idx(i, j, k));
     let mut conn = Vec::with_capacity(8 * n[0] * n[1] * n[2]);
     for k in 0..n[2] {
         for j in 0..n[1] {
@@ -128,29 +101,14 @@ pub fn cuboid_hexes(
             }
         }
     }
-    let face = |axis: usize, at: usize| {
-        let mut nodes = Vec::new();
-        for k in 0..=n[2] {
-            for j in 0..=n[1] {
-                for i in 0..=n[0] {
-                    if [i, j, k][axis] == at {
-                        nodes.push(idx(i, j, k));
-                    }
-                }
-            }
-        }
-        nodes
-    };
-    let boundaries = vec![
-        ("xmin", face(0, 0)),
-        ("xmax", face(0, n[0])),
-        ("ymin", face(1, 0)),
-        ("ymax", face(1, n[1])),
-        ("zmin", face(2, 0)),
-        ("zmax", face(2, n[2])),
-    ];
+    let boundaries = grid.boundaries();
     let cells = n[0] * n[1] * n[2];
-    finish_cells(coords, vec![ElementKind::Hex8; cells], conn, boundaries)
+    finish_cells(
+        grid.coords,
+        vec![ElementKind::Hex8; cells],
+        conn,
+        boundaries,
+    )
 }
 
 /// Annulus `r_in <= |x - center| <= r_out` (m) of Quad4 cells on a polar grid: `n`

@@ -227,18 +227,7 @@ pub fn run(backend: &Backend, p: &Params, solver: Solver) -> Result<Outcome, Sce
             max_steps: 5,
             check_every: 1,
         })?,
-        Solver::Relaxation => sim.relax(&StaticOptions {
-            // f32 forces carry ~1e-7 relative noise, which the unbalanced-force ratio
-            // (net over gross) sees amplified; 1e-5 is safely reachable in f32, and the
-            // f32 stress error is then reported as measured.
-            tolerance: if backend.precision_kind() == pcdc_compute::Precision::F32 {
-                1e-5
-            } else {
-                1e-6
-            },
-            max_steps: 400_000,
-            check_every: 50,
-        })?,
+        Solver::Relaxation => sim.relax(&super::relax_options(backend))?,
     };
     let stress = output::global_stress(&sim)?;
     let wall_s = start.elapsed().as_secs_f64();

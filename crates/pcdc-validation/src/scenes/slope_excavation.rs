@@ -27,7 +27,7 @@
 
 use std::time::Instant;
 
-use pcdc_compute::{Backend, Simulation, StaticOptions};
+use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::mohr_coulomb::{state, MC_STATE};
 use pcdc_mech::{
     output, reset_displacement, set_null, Boundary, Constraint, InitialStress, LinearElastic,
@@ -195,15 +195,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
                 .constraint(Range::group("bottom"), Constraint::Fixed),
         )
         .build()?;
-    let opts = StaticOptions {
-        tolerance: if backend.precision_kind() == pcdc_compute::Precision::F32 {
-            1e-5
-        } else {
-            1e-6
-        },
-        max_steps: 400_000,
-        check_every: 50,
-    };
+    let opts = super::relax_options(backend);
     let first = sim.relax(&opts)?;
     let mut steps = first.steps;
     let error = far_field_error(&sim, p.size)?;

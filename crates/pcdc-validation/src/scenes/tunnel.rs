@@ -23,7 +23,7 @@
 
 use std::time::Instant;
 
-use pcdc_compute::{Backend, Simulation, StaticOptions, Table};
+use pcdc_compute::{Backend, Simulation, Table};
 use pcdc_mech::mohr_coulomb::{state, MC_STATE};
 use pcdc_mech::{output, Boundary, FaceStress, LinearElastic, Mechanics, MohrCoulomb};
 use pcdc_mesh::Range;
@@ -163,15 +163,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
                 ),
         ))
         .build()?;
-    let opts = StaticOptions {
-        tolerance: if backend.precision_kind() == pcdc_compute::Precision::F32 {
-            1e-5
-        } else {
-            1e-6
-        },
-        max_steps: 400_000,
-        check_every: 50,
-    };
+    let opts = super::relax_options(backend);
     let mut steps = 0;
     for k in 1..=STAGES {
         sim.state.time = k as f64 / STAGES as f64;
