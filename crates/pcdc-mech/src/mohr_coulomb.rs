@@ -6,7 +6,8 @@
 //! In 2D (plane strain) σzz is one of the three.
 //!
 //! * **(25)–(28)** elastic trial σ* = σ(t) + C:Δε, computed in Cartesian components and
-//!   then decomposed ([`crate::principal`]); in principal axes Δσ_i = α1 Δε_i + α2 Σ_{j≠i}
+//!   then decomposed ([`crate::principal`]; in plane strain in closed form,
+//!   [`crate::principal::plane`]); in principal axes Δσ_i = α1 Δε_i + α2 Σ_{j≠i}
 //!   Δε_j, α1 = K + 4G/3, α2 = K − 2G/3.
 //! * **(29)** \[CORRECTED\] shear yield f_s = −σ1 + σ3 N_φ − 2c √N_φ (printed with N_φ where
 //!   √N_φ belongs); failure when f_s > 0.
@@ -46,7 +47,10 @@
 //! `model_state` field): `[0]` shear now, `[1]` shear in the past, `[2]` tension now,
 //! `[3]` tension in the past (1 or 0; "now" is this step, "past" any step since the last
 //! `reset_element_state`), `[4]` accumulated plastic shear strain κ_s (FLAC's measure,
-//! Δκ_s = √(½(Δε1ᵖ − Δεmᵖ)² + ½(Δεmᵖ)² + ½(Δε3ᵖ − Δεmᵖ)²), Δεmᵖ = (Δε1ᵖ + Δε3ᵖ)/3),
+//! Δκ_s = √(½ Σ_i (Δε_iᵖ − Δεmᵖ)²), Δεmᵖ = (Δε1ᵖ + Δε2ᵖ + Δε3ᵖ)/3 over the shear
+//! planes' flow: on the shear plane alone (Δε2ᵖ = 0) exactly FLAC's
+//! √(½(Δε1ᵖ − Δεmᵖ)² + ½(Δεmᵖ)² + ½(Δε3ᵖ − Δεmᵖ)²); on an edge it also counts the middle
+//! component, which FLAC's form drops),
 //! `[5]` accumulated plastic tensile strain κ_t (the tension planes' multipliers summed).
 
 use serde::{Deserialize, Serialize};
@@ -54,7 +58,7 @@ use serde::{Deserialize, Serialize};
 use pcdc_compute::Table;
 
 use crate::model::{add_hooke, ConstitutiveModel, LinearElastic, Sym6, WgslModel};
-use crate::principal::{compose, principal, JACOBI_STOP};
+use crate::principal::{compose, compose_plane, plane, principal, JACOBI_STOP};
 use crate::MechError;
 
 /// Number of history variables of [`MohrCoulomb`].
@@ -699,19 +703,32 @@ impl ConstitutiveModel for MohrCoulomb {
         if surfaces.surely_elastic(stress) {
             return;
         }
-        let p = principal(stress);
-        let Some(r) = surfaces.return_map(&p.values) else {
-            return;
+        // Plane strain in closed form, else Jacobi (the same values to rounding).
+        let r = if stress[4] == 0.0 && stress[5] == 0.0 {
+            let p = plane(stress);
+            let Some(r) = surfaces.return_map(&p.values) else {
+                return;
+            };
+            *stress = compose_plane(&r.stress, &p);
+            r
+        } else {
+            let p = principal(stress);
+            let Some(r) = surfaces.return_map(&p.values) else {
+                return;
+            };
+            *stress = compose(&r.stress, &p.axes);
+            r
         };
-        *stress = compose(&r.stress, &p.axes);
         if r.shear > 0.0 {
             st[state::SHEAR_NOW] = 1.0;
             st[state::SHEAR_PAST] = 1.0;
-            // FLAC's shear hardening parameter from the shear planes' plastic strain.
+            // FLAC's shear hardening parameter from the shear planes' plastic strain, in
+            // its symmetric form (all three components: on an edge the middle one is not
+            // zero).
             let ep = r.shear_strain;
-            let m = (ep[0] + ep[2]) * (1.0 / 3.0);
-            st[state::SHEAR_STRAIN] +=
-                (0.5 * ((ep[0] - m).powi(2) + m * m + (ep[2] - m).powi(2))).sqrt();
+            let m = (ep[0] + ep[1] + ep[2]) * (1.0 / 3.0);
+            let (a, b, c) = (ep[0] - m, ep[1] - m, ep[2] - m);
+            st[state::SHEAR_STRAIN] += (0.5 * (a * a + b * b + c * c)).sqrt();
         }
         if r.tension > 0.0 {
             st[state::TENSION_NOW] = 1.0;

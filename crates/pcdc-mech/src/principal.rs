@@ -102,6 +102,62 @@ fn rotate(a: &mut [[f64; 3]; 3], v: &mut [[f64; 3]; 3], p: usize, q: usize) {
     }
 }
 
+/// Principal values of a plane tensor (yz = xz = 0: plane strain) in closed form, with
+/// what [`compose_plane`] needs to rebuild a tensor on the same axes. In the plane the
+/// values are c ∓ r, c = (xx + yy)/2, r = √(((xx − yy)/2)² + xy²), the major one on the
+/// axis at θ with (cos 2θ, sin 2θ) = ((xx − yy)/2, xy)/r; zz is the third value. The
+/// elastic-plastic models take this path in 2D: one square root and one division where
+/// [`principal`] rotates and carries a 3×3 frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanePrincipal {
+    /// Principal values, ascending (as [`Principal::values`]).
+    pub values: [f64; 3],
+    /// cos 2θ and sin 2θ of the in-plane major axis; (−1, 0) when the in-plane values are
+    /// equal (any axes would do; this is the frame [`principal`] keeps).
+    pub cos_sin_2theta: [f64; 2],
+    /// Where the in-plane minor value, the in-plane major value and zz sit in `values`.
+    pub slots: [usize; 3],
+}
+
+/// Decomposes a plane tensor `t` (xx, yy, zz, xy, yz = 0, xz = 0); see [`PlanePrincipal`].
+/// The yz and xz components are not read.
+pub fn plane(t: &Sym6) -> PlanePrincipal {
+    let c = 0.5 * (t[0] + t[1]);
+    let d = 0.5 * (t[0] - t[1]);
+    let r = (d * d + t[3] * t[3]).sqrt();
+    let cos_sin_2theta = if r > 0.0 {
+        let inv = 1.0 / r;
+        [d * inv, t[3] * inv]
+    } else {
+        // Major on y, minor on x: the frame [`principal`] leaves (identity, stable order).
+        [-1.0, 0.0]
+    };
+    let (lo, hi, zz) = (c - r, c + r, t[2]);
+    let (values, slots) = if zz <= lo {
+        ([zz, lo, hi], [1, 2, 0])
+    } else if zz >= hi {
+        ([lo, hi, zz], [0, 1, 2])
+    } else {
+        ([lo, zz, hi], [0, 2, 1])
+    };
+    PlanePrincipal {
+        values,
+        cos_sin_2theta,
+        slots,
+    }
+}
+
+/// The plane tensor with principal values `values` (ordered as [`PlanePrincipal::values`]
+/// was, not re-sorted) on the axes of `p`: the inverse of [`plane`].
+pub fn compose_plane(values: &[f64; 3], p: &PlanePrincipal) -> Sym6 {
+    let [minor, major, zz] = p.slots;
+    let (a, b) = (values[minor], values[major]);
+    let c = 0.5 * (a + b);
+    let r = 0.5 * (b - a);
+    let [cos2, sin2] = p.cos_sin_2theta;
+    [c + r * cos2, c - r * cos2, values[zz], r * sin2, 0.0, 0.0]
+}
+
 /// The tensor Σ_i `values[i]` axes_i ⊗ axes_i (xx, yy, zz, xy, yz, xz): the inverse of
 /// [`principal`] for new principal values on the same axes.
 pub fn compose(values: &[f64; 3], axes: &[[f64; 3]; 3]) -> Sym6 {
@@ -153,6 +209,50 @@ mod tests {
         assert_eq!(p.values[z], -2.0);
         let back = compose(&p.values, &p.axes);
         assert_eq!((back[4], back[5]), (0.0, 0.0));
+    }
+
+    #[test]
+    fn plane_closed_form_matches_jacobi_and_round_trips() {
+        // Every order of zz against the in-plane pair, an in-plane isotropic tensor, and
+        // signs of xy and xx − yy.
+        let cases = [
+            [3.0, -2.0, 0.5, 1.25],
+            [3.0, -2.0, -9.0, -1.25],
+            [3.0, -2.0, 9.0, 0.0],
+            [-2.0, 3.0, 0.0, 4.0],
+            [1.5, 1.5, -1.0, 0.0],
+            [-1e7, -3e7, -2e7, 5e6],
+        ];
+        for c in cases {
+            let t = [c[0], c[1], c[2], c[3], 0.0, 0.0];
+            let sc = 4.0 * c.iter().fold(0.0f64, |m: f64, v: &f64| m.max(v.abs()));
+            let p = plane(&t);
+            let j = principal(&t);
+            for k in 0..3 {
+                assert!(
+                    close(p.values[k], j.values[k], sc),
+                    "{c:?}: {:?} vs {:?}",
+                    p.values,
+                    j.values
+                );
+            }
+            let back = compose_plane(&p.values, &p);
+            for k in 0..6 {
+                assert!(
+                    close(back[k], t[k], sc),
+                    "{c:?} {k}: {} vs {}",
+                    back[k],
+                    t[k]
+                );
+            }
+            // New values on the same axes: as the Jacobi frame composes them.
+            let new = [p.values[0] - 0.25, p.values[1] + 0.5, p.values[2] * 0.5];
+            let a = compose_plane(&new, &p);
+            let b = compose(&new, &j.axes);
+            for k in 0..6 {
+                assert!(close(a[k], b[k], sc), "{c:?} {k}: {} vs {}", a[k], b[k]);
+            }
+        }
     }
 
     #[test]

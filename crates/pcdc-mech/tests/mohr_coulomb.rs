@@ -183,6 +183,31 @@ proptest! {
         prop_assert_eq!(r.shear, 0.0);
     }
 
+    /// A point on an edge of the pyramid (σ2 = σ3, triaxial compression, or σ2 = σ1,
+    /// extension), pushed out along both planes' elastic images by λ0, λ1, returns to
+    /// itself with plastic strain λ0 ∇g0 + λ1 ∇g_edge: the closed-form edge returns.
+    #[test]
+    fn edge_returns_recover_both_multipliers(
+        m in params(), u in 0.05..0.95f64, l0 in 1e-6..1e-2f64, l1 in 1e-6..1e-2f64,
+        compression in any::<bool>()
+    ) {
+        let s = m.surfaces();
+        let (l0, l1) = (l0 * s.kc / s.a1, l1 * s.kc / s.a1);
+        let s3 = s.st - (0.2 + u) * s.kc;
+        let s1 = s.n_phi * s3 - s.kc;
+        let (on, edge) = if compression { ([s1, s3, s3], 1) } else { ([s1, s1, s3], 2) };
+        let (g0, g1) = (s.potential_gradient(0), s.potential_gradient(edge));
+        let trial = add(&add(&on, &s.elastic(&g0), l0), &s.elastic(&g1), l1);
+        let r = s.return_map(&trial).expect("outside");
+        for i in 0..3 {
+            prop_assert!((r.stress[i] - on[i]).abs() <= 1e-9 * s.kc, "{:?} vs {:?}", r.stress, on);
+            let ep = l0 * g0[i] + l1 * g1[i];
+            prop_assert!((r.plastic_strain[i] - ep).abs() <= 1e-8 * (l0 + l1), "{:?}", r.plastic_strain);
+        }
+        prop_assert!((r.shear - (l0 + l1)).abs() <= 1e-8 * (l0 + l1));
+        prop_assert_eq!(r.tension, 0.0);
+    }
+
     /// The decomposition-free elastic bound never calls a plastic state elastic.
     #[test]
     fn surely_elastic_is_never_wrong(m in params(), t in tensor(1.0), k in 0.1..30.0f64) {

@@ -17,20 +17,37 @@ let f = mc_surfaces(p, (*state)[4], (*state)[5]);
 if mc_surely_elastic(f, s) {
     return s;
 }
-let pr = mc_principal(s, param(p, 8u));
-let r = mc_return(f, pr.values, param(p, 9u));
+// Plane strain in closed form, else Jacobi.
+let flat = s[4] == 0.0 && s[5] == 0.0;
+var values: McV3;
+var pr: McPrin;
+var p2: McPrin2;
+if flat {
+    p2 = mc_principal_2d(s);
+    values = p2.values;
+} else {
+    pr = mc_principal(s, param(p, 8u));
+    values = pr.values;
+}
+let r = mc_return(f, values, param(p, 9u));
 if !r.ok {
     return s;
 }
 if r.shear > 0.0 {
     (*state)[0] = 1.0;
     (*state)[1] = 1.0;
-    let m = (r.eps[0] + r.eps[2]) * (1.0 / 3.0);
-    (*state)[4] = (*state)[4] + sqrt(0.5 * ((r.eps[0] - m) * (r.eps[0] - m) + m * m + (r.eps[2] - m) * (r.eps[2] - m)));
+    let m = (r.eps[0] + r.eps[1] + r.eps[2]) * (1.0 / 3.0);
+    let ea = r.eps[0] - m;
+    let eb = r.eps[1] - m;
+    let ec = r.eps[2] - m;
+    (*state)[4] = (*state)[4] + sqrt(0.5 * (ea * ea + eb * eb + ec * ec));
 }
 if r.tension > 0.0 {
     (*state)[2] = 1.0;
     (*state)[3] = 1.0;
     (*state)[5] = (*state)[5] + r.tension;
+}
+if flat {
+    return mc_compose_2d(r.s, p2);
 }
 return mc_compose(r.s, pr.axes);

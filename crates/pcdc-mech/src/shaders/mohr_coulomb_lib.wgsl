@@ -357,6 +357,48 @@ fn mc_principal(t: Sym, jtol: Real) -> McPrin {
     return out;
 }
 
+// principal.rs: plane (closed form for yz = xz = 0).
+struct McPrin2 {
+    values: McV3,
+    cs: array<Real, 2>,
+    slots: array<u32, 3>,
+}
+
+fn mc_principal_2d(t: Sym) -> McPrin2 {
+    let c = 0.5 * (t[0] + t[1]);
+    let d = 0.5 * (t[0] - t[1]);
+    let r = sqrt(d * d + t[3] * t[3]);
+    var out: McPrin2;
+    out.cs = array<Real, 2>(-1.0, 0.0);
+    if r > 0.0 {
+        let inv = 1.0 / r;
+        out.cs = array<Real, 2>(d * inv, t[3] * inv);
+    }
+    let lo = c - r;
+    let hi = c + r;
+    let zz = t[2];
+    if zz <= lo {
+        out.values = McV3(zz, lo, hi);
+        out.slots = array<u32, 3>(1u, 2u, 0u);
+    } else if zz >= hi {
+        out.values = McV3(lo, hi, zz);
+        out.slots = array<u32, 3>(0u, 1u, 2u);
+    } else {
+        out.values = McV3(lo, zz, hi);
+        out.slots = array<u32, 3>(0u, 2u, 1u);
+    }
+    return out;
+}
+
+// principal.rs: compose_plane.
+fn mc_compose_2d(values: McV3, p: McPrin2) -> Sym {
+    let a = values[p.slots[0]];
+    let b = values[p.slots[1]];
+    let c = 0.5 * (a + b);
+    let r = 0.5 * (b - a);
+    return Sym(c + r * p.cs[0], c - r * p.cs[0], values[p.slots[2]], r * p.cs[1], 0.0, 0.0);
+}
+
 // principal.rs: compose.
 fn mc_compose(values: McV3, axes: array<McV3, 3>) -> Sym {
     var t = Sym(0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
