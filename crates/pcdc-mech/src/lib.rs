@@ -134,6 +134,7 @@ mod model;
 pub mod mohr_coulomb;
 pub mod output;
 pub mod principal;
+pub mod thermal_strain;
 
 pub use actions::{
     reset_displacement, reset_element_state, reset_velocity, set_null, set_velocity,
@@ -145,3 +146,4 @@ pub use initial_stress::InitialStress;
 pub use mechanics::{Mechanics, SurfaceProperties};
 pub use model::{double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};
 pub use mohr_coulomb::{MohrCoulomb, Softening};
+pub use thermal_strain::ThermalStrain;

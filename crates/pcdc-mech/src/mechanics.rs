@@ -1202,15 +1202,25 @@ impl<D: Dim> Physics<D> for Mechanics {
         } else {
             ""
         };
-        // Helper functions once per distinct model code.
+        // Helper functions once per distinct model code; a wrapper's functions start
+        // with its inner model's (`ThermalStrain`), which are spliced once even when
+        // the inner model is also used unwrapped.
         let mut functions = String::new();
         let mut seen: Vec<&str> = Vec::new();
         for w in &bodies {
-            if !seen.contains(&w.key.as_str()) {
-                seen.push(&w.key);
-                functions.push_str(&w.functions);
-                functions.push('\n');
+            let f = w.functions.as_str();
+            if seen.iter().any(|s| s.starts_with(f)) {
+                continue;
             }
+            let done = seen
+                .iter()
+                .filter(|s| !s.is_empty() && f.starts_with(**s))
+                .map(|s| s.len())
+                .max()
+                .unwrap_or(0);
+            seen.push(f);
+            functions.push_str(&f[done..]);
+            functions.push('\n');
         }
         let source = format!(
             "alias Sym = array<Real, 6>;\nalias ModelState = array<Real, NSTATE>;\nfn param(p: u32, k: u32) -> Real {{ return mat_params[p + k]; }}\n{coupling_src}{functions}{}{mixed_lib}{template}",

@@ -1,0 +1,659 @@
+//! The thermal physics: [`Thermal`], its builder and its stages.
+
+use std::sync::Arc;
+
+use pcdc_compute::names::{JOINT_DAMAGE, TEMPERATURE};
+use pcdc_compute::{
+    ComputeError, Entity, EntityKind, FieldContext, FieldId, FieldSchedule, FieldStore, FieldUse,
+    ForceContext, InitContext, KinematicNodes, Kinematics, Physics, StableStep, TimeValue,
+};
+use pcdc_mesh::{Dim, Mesh, Range};
+use rayon::prelude::*;
+
+use crate::boundary::{self, FaceHeat, NodeEntries};
+use crate::conduction::{self, Geometry};
+use crate::fields::{HEAT_CAPACITY, HEAT_FLUX, HEAT_SUPPLIED};
+use crate::HeatMaterial;
+
+/// Elements (or nodes) per parallel block.
+const CHUNK: usize = 2048;
+/// No temperature condition on a node.
+const FREE: u32 = u32::MAX;
+
+/// How heat crosses the joints of a split (FDEM) mesh.
+///
+/// \[NOT IN MANUAL: the manual conducts through contact only (eq. 111–112) and is
+/// silent on intact joints.\] An intact joint is rock that has not cracked, so by default
+/// it conducts as the rock does: the split copies of a vertex joined by intact joints
+/// form one thermal node (their rates and capacities are summed, they share one
+/// temperature), exactly the conduction of the unsplit mesh, with no interface
+/// conductance to choose and no smaller stable step. A broken joint insulates (contact
+/// conductance across open cracks is not modelled yet), so cracks act as the thermal
+/// barriers they are.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum JointHeat {
+    /// Intact joints conduct, broken ones (damage 1, `names::JOINT_DAMAGE`, owned by
+    /// the cohesive joints, which must then be composed) insulate. The default.
+    #[default]
+    FollowDamage,
+    /// Every joint conducts, broken or not (the damage is not read).
+    Conducting,
+    /// No joint conducts: every element is thermally isolated from its neighbours.
+    Insulating,
+}
+
+/// A user function of position, for the initial temperature.
+type PointFn = Arc<dyn Fn(&[f64]) -> f64 + Send + Sync>;
+
+#[derive(Clone)]
+enum Initial {
+    Uniform(f64),
+    Function(PointFn),
+}
+
+/// Heat conduction in the solid with boundary heat (manual 7.6.1–7.6.2, 7.6.8); see the
+/// crate documentation for the equations.
+///
+/// ```
+/// use pcdc_compute::{names, Backend, Simulation};
+/// use pcdc_mesh::{builders, Range};
+/// use pcdc_thermal::{HeatMaterial, Thermal};
+///
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let mesh = builders::rectangle(0.0, 0.0, 1.0, 0.1, 0.05)?;
+/// let granite = HeatMaterial::new(3.0, 800.0, 2700.0)?; // k, C_s, ρ
+/// let heat = Thermal::new()
+///     .material(Range::All, granite)
+///     .initial_temperature(20.0)
+///     .temperature(Range::group("left"), 100.0)
+///     .heat_only(); // no mechanics: one thermal step per step
+/// let mut sim = Simulation::builder(mesh, Backend::cpu(1)?).physics(heat).build()?;
+/// sim.run(100)?;
+/// let t = sim.field(names::TEMPERATURE)?;
+/// assert!(t.iter().all(|&t| (20.0..=100.0).contains(&t)));
+/// # Ok(())
+/// # }
+/// ```
+#[derive(Clone)]
+pub struct Thermal {
+    materials: Vec<(Range, HeatMaterial)>,
+    initial: Initial,
+    fixed: Vec<(Range, TimeValue)>,
+    faces: Vec<(Range, FaceHeat)>,
+    joints: JointHeat,
+    schedule: FieldSchedule,
+    heat_only: bool,
+    derived: Option<Derived>,
+}
+
+impl Default for Thermal {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// What init derives from the mesh.
+#[derive(Clone, Default)]
+struct Derived {
+    geo: Geometry,
+    /// Material index of each element.
+    material: Vec<u32>,
+    /// k_ij of each material.
+    k: Vec<[[f64; 3]; 3]>,
+    /// Lumped heat capacity C_l of each node (J/K; J/(m·K) in 2D).
+    capacity: Vec<f64>,
+    /// Node → element-rate slots (e · N_e + a), ascending.
+    slot_start: Vec<u32>,
+    slots: Vec<u32>,
+    entries: NodeEntries,
+    /// Temperature condition of each node, or [`FREE`].
+    fixed_of: Vec<u32>,
+    groups: Groups,
+    /// Joints that no longer conduct (broken, with [`JointHeat::FollowDamage`]).
+    broken: Vec<bool>,
+    stable: Option<StableStep>,
+    ids: Option<Ids>,
+    // Work arrays.
+    rates: Vec<f64>,
+    node_rate: Vec<f64>,
+    node_bnd: Vec<f64>,
+    group_temp: Vec<[f64; 2]>,
+}
+
+#[derive(Clone, Copy)]
+struct Ids {
+    temp: FieldId,
+    flux: FieldId,
+    supplied: FieldId,
+    capacity: FieldId,
+    damage: Option<FieldId>,
+}
+
+/// Thermal nodes: the mesh nodes joined through conducting joints (CSR, members
+/// ascending, groups ordered by their first member).
+#[derive(Clone, Debug, Default)]
+struct Groups {
+    of: Vec<u32>,
+    start: Vec<u32>,
+    members: Vec<u32>,
+}
+
+impl Groups {
+    /// The groups of `n` nodes joined by the node pairs of the conducting joints.
+    fn build<D: Dim>(mesh: &Mesh<D>, conducts: impl Fn(usize) -> bool) -> Self {
+        let n = mesh.n_nodes();
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                p[x as usize] = p[p[x as usize] as usize];
+                x = p[x as usize];
+            }
+            x
+        }
+        let joints = mesh.interfaces();
+        for j in 0..joints.len() {
+            if !conducts(j) {
+                continue;
+            }
+            let Some(iface) = joints.get(j) else { continue };
+            for (a, b) in iface.node_pairs() {
+                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+                // The smaller root wins: groups are named by their first member.
+                let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+                parent[hi as usize] = lo;
+            }
+        }
+        let mut of = vec![0u32; n];
+        let mut index_of_root = vec![u32::MAX; n];
+        let mut count = Vec::new();
+        for v in 0..n as u32 {
+            let r = find(&mut parent, v);
+            if index_of_root[r as usize] == u32::MAX {
+                index_of_root[r as usize] = count.len() as u32;
+                count.push(0u32);
+            }
+            let g = index_of_root[r as usize];
+            of[v as usize] = g;
+            count[g as usize] += 1;
+        }
+        let mut start = Vec::with_capacity(count.len() + 1);
+        start.push(0u32);
+        for c in &count {
+            start.push(start.last().copied().unwrap_or(0) + c);
+        }
+        let mut fill: Vec<u32> = start[..count.len()].to_vec();
+        let mut members = vec![0u32; n];
+        for v in 0..n {
+            let g = of[v] as usize;
+            members[fill[g] as usize] = v as u32;
+            fill[g] += 1;
+        }
+        Groups { of, start, members }
+    }
+
+    fn len(&self) -> usize {
+        self.start.len() - 1
+    }
+}
+
+impl Thermal {
+    /// No materials, initial temperature 0, no conditions (adiabatic boundary), joints
+    /// [`JointHeat::FollowDamage`], schedule [`FieldSchedule::Auto`].
+    pub fn new() -> Self {
+        Thermal {
+            materials: Vec::new(),
+            initial: Initial::Uniform(0.0),
+            fixed: Vec::new(),
+            faces: Vec::new(),
+            joints: JointHeat::default(),
+            schedule: FieldSchedule::Auto,
+            heat_only: false,
+            derived: None,
+        }
+    }
+
+    /// Assigns a material to the elements in `range` (later assignments win). Every
+    /// element needs one.
+    pub fn material(mut self, range: Range, material: HeatMaterial) -> Self {
+        self.materials.push((range, material));
+        self
+    }
+
+    /// Uniform initial temperature (K or °C).
+    pub fn initial_temperature(mut self, t: f64) -> Self {
+        self.initial = Initial::Uniform(t);
+        self
+    }
+
+    /// Initial temperature as a function of the node position (m).
+    pub fn initial_temperature_fn(
+        mut self,
+        f: impl Fn(&[f64]) -> f64 + Send + Sync + 'static,
+    ) -> Self {
+        self.initial = Initial::Function(Arc::new(f));
+        self
+    }
+
+    /// Holds the nodes in `range` at temperature `t` (constant or time table; manual
+    /// table 14). Where ranges overlap, the last condition wins.
+    pub fn temperature(mut self, range: Range, t: impl Into<TimeValue>) -> Self {
+        self.fixed.push((range, t.into()));
+        self
+    }
+
+    /// A heat flux density q_n (W/m², positive into the body; 2D: per metre of
+    /// thickness) on the boundary faces in `range` (table 16, eq. 101 shares).
+    pub fn heat_flux(mut self, range: Range, q: impl Into<TimeValue>) -> Self {
+        self.faces.push((range, FaceHeat::Flux(q.into())));
+        self
+    }
+
+    /// Convection h (T_env − T) on the boundary faces in `range` (eq. 100–101; h ≥ 0 in
+    /// W/(m²·K), T_env constant or a time table).
+    pub fn convection(mut self, range: Range, h: f64, t_env: impl Into<TimeValue>) -> Self {
+        self.faces
+            .push((range, FaceHeat::Convection(h, t_env.into())));
+        self
+    }
+
+    /// How heat crosses the joints of a split mesh ([`JointHeat`]).
+    pub fn joints(mut self, joints: JointHeat) -> Self {
+        self.joints = joints;
+        self
+    }
+
+    /// The thermal stage's schedule relative to the mechanical step (default
+    /// [`FieldSchedule::Auto`]: from the stable steps, reported by
+    /// `Simulation::field_stages`).
+    pub fn schedule(mut self, schedule: FieldSchedule) -> Self {
+        self.schedule = schedule;
+        self
+    }
+
+    /// Heat without mechanics: the physics gives every mesh node a unit mass and sets
+    /// the step to its own stable step, so a simulation of this physics alone advances
+    /// one thermal step per step. Do not combine with a mechanics.
+    pub fn heat_only(mut self) -> Self {
+        self.heat_only = true;
+        self
+    }
+
+    fn reads_damage<D: Dim>(&self, mesh: &Mesh<D>) -> bool {
+        self.joints == JointHeat::FollowDamage && !mesh.interfaces().is_empty()
+    }
+
+    fn derive<D: Dim>(&self, mesh: &Mesh<D>) -> Result<Derived, ComputeError> {
+        let (d, npe, ne, nn) = (D::D, D::NODES_PER_ELEM, mesh.n_elements(), mesh.n_nodes());
+        if self.materials.is_empty() {
+            return Err(ComputeError::param(
+                "thermal material",
+                "none",
+                "give every element a HeatMaterial (Thermal::material)",
+            ));
+        }
+        let mut material = vec![u32::MAX; ne];
+        let mut k = Vec::with_capacity(self.materials.len());
+        for (m, (range, mat)) in self.materials.iter().enumerate() {
+            mat.check_dim(d)?;
+            k.push(mat.conductivity().tensor(d));
+            let sel = mesh.select_elements(range).map_err(|e| {
+                ComputeError::param(format!("thermal material {m}"), "range", e.to_string())
+            })?;
+            for e in sel {
+                material[e as usize] = m as u32;
+            }
+        }
+        if let Some(e) = material.iter().position(|&m| m == u32::MAX) {
+            return Err(ComputeError::param(
+                format!("element {e}"),
+                "no thermal material",
+                "every element needs a HeatMaterial (Thermal::material)",
+            ));
+        }
+        let geo = Geometry::of(mesh)?;
+        let conn = mesh.elements();
+        // Lumped capacity (eq. 94) and the node → slot map.
+        let mut capacity = vec![0.0; nn];
+        let mut count = vec![0u32; nn];
+        for e in 0..ne {
+            let mat = &self.materials[material[e] as usize].1;
+            let c = mat.density() * mat.capacity() * geo.measure[e] / npe as f64;
+            for &n in &conn[e * npe..(e + 1) * npe] {
+                capacity[n as usize] += c;
+                count[n as usize] += 1;
+            }
+        }
+        let mut slot_start = Vec::with_capacity(nn + 1);
+        slot_start.push(0u32);
+        for c in &count {
+            slot_start.push(slot_start.last().copied().unwrap_or(0) + c);
+        }
+        let mut fill: Vec<u32> = slot_start[..nn].to_vec();
+        let mut slots = vec![0u32; ne * npe];
+        for (s, &n) in conn.iter().enumerate() {
+            slots[fill[n as usize] as usize] = s as u32;
+            fill[n as usize] += 1;
+        }
+        for (i, (_, heat)) in self.faces.iter().enumerate() {
+            boundary::check(i, heat)?;
+        }
+        let entries = NodeEntries::build(mesh, &self.faces)?;
+        let mut fixed_of = vec![FREE; nn];
+        for (c, (range, t)) in self.fixed.iter().enumerate() {
+            t.check(&format!("temperature of thermal condition {c}"))?;
+            let nodes = mesh.select_nodes(range).map_err(|e| {
+                ComputeError::param(
+                    format!("thermal temperature condition {c}"),
+                    "range",
+                    e.to_string(),
+                )
+            })?;
+            if nodes.is_empty() {
+                return Err(ComputeError::param(
+                    format!("thermal temperature condition {c}"),
+                    "range",
+                    "selects no node",
+                ));
+            }
+            for n in nodes {
+                fixed_of[n as usize] = c as u32;
+            }
+        }
+        let nj = mesh.interfaces().len();
+        let broken = vec![self.joints == JointHeat::Insulating; nj];
+        let groups = Groups::build(mesh, |j| !broken[j]);
+        // Stable step: Gershgorin on C⁻¹K per node, convection included; valid for any
+        // grouping (a group's ratio is at least its members' smallest).
+        let mut rows = vec![0.0; nn];
+        let mut local = [0.0; 4];
+        for e in 0..ne {
+            local.fill(0.0);
+            let g = &geo.grad[e * npe * d..(e + 1) * npe * d];
+            conduction::row_sums(
+                d,
+                g,
+                geo.measure[e],
+                &k[material[e] as usize],
+                &mut local[..npe],
+            );
+            for (a, &n) in conn[e * npe..(e + 1) * npe].iter().enumerate() {
+                rows[n as usize] += local[a];
+            }
+        }
+        for n in 0..nn {
+            for i in entries.start[n] as usize..entries.start[n + 1] as usize {
+                if let FaceHeat::Convection(h, _) = &self.faces[entries.cond[i] as usize].1 {
+                    rows[n] += h * entries.share[i];
+                }
+            }
+        }
+        let stable = (0..nn)
+            .filter(|&n| rows[n] > 0.0)
+            .map(|n| (2.0 * capacity[n] / rows[n], n))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(dt, n)| StableStep {
+                dt,
+                entity: Entity::new(EntityKind::Node, n),
+                physics: "thermal".into(),
+            });
+        Ok(Derived {
+            rates: vec![0.0; ne * npe],
+            node_rate: vec![0.0; nn],
+            node_bnd: vec![0.0; nn],
+            group_temp: vec![[0.0; 2]; groups.len()],
+            geo,
+            material,
+            k,
+            capacity,
+            slot_start,
+            slots,
+            entries,
+            fixed_of,
+            groups,
+            broken,
+            stable,
+            ids: None,
+        })
+    }
+}
+
+impl<D: Dim> Physics<D> for Thermal {
+    fn name(&self) -> &str {
+        "thermal"
+    }
+
+    fn fields(&self, mesh: &Mesh<D>) -> Vec<FieldUse> {
+        let mut f = vec![
+            TEMPERATURE.own::<D>(),
+            HEAT_FLUX.own::<D>(),
+            HEAT_SUPPLIED.own::<D>(),
+            HEAT_CAPACITY.own::<D>(),
+        ];
+        if self.reads_damage(mesh) {
+            f.push(JOINT_DAMAGE.read_lagged::<D>());
+        }
+        f
+    }
+
+    fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
+        let mut d = self.derive(ctx.mesh)?;
+        let fields = &mut *ctx.fields;
+        let ids = Ids {
+            temp: fields.id(TEMPERATURE)?,
+            flux: fields.id(HEAT_FLUX)?,
+            supplied: fields.id(HEAT_SUPPLIED)?,
+            capacity: fields.id(HEAT_CAPACITY)?,
+            damage: if self.reads_damage(ctx.mesh) {
+                Some(fields.id(JOINT_DAMAGE)?)
+            } else {
+                None
+            },
+        };
+        fields.get_mut(ids.capacity).copy_from_slice(&d.capacity);
+        let temp = fields.get_mut(ids.temp);
+        for (n, t) in temp.iter_mut().enumerate() {
+            let x = ctx.mesh.node(n);
+            let v = match &self.initial {
+                Initial::Uniform(t) => *t,
+                Initial::Function(f) => f(x),
+            };
+            if !v.is_finite() {
+                return Err(ComputeError::param(
+                    format!("initial temperature at node {n} ({x:?})"),
+                    v,
+                    "must be finite",
+                ));
+            }
+            *t = match d.fixed_of[n] {
+                FREE => v,
+                c => self.fixed[c as usize].1.at(0.0),
+            };
+        }
+        d.ids = Some(ids);
+        self.derived = Some(d);
+        Ok(())
+    }
+
+    fn add_mass(
+        &self,
+        mesh: &Mesh<D>,
+        _fields: &FieldStore,
+        mass: &mut [f64],
+        _scale_to_dt: Option<f64>,
+    ) {
+        if self.heat_only {
+            for m in &mut mass[..mesh.n_nodes()] {
+                *m += 1.0;
+            }
+        }
+    }
+
+    fn stable_step(&self, _kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
+        if self.heat_only {
+            self.derived.as_ref()?.stable.clone()
+        } else {
+            None
+        }
+    }
+
+    fn field_schedule(&self) -> Option<FieldSchedule> {
+        Some(self.schedule)
+    }
+
+    fn field_stable_step(&self, _kin: &Kinematics<'_, D>, _f: &FieldStore) -> Option<StableStep> {
+        self.derived.as_ref()?.stable.clone()
+    }
+
+    fn kinematic_nodes(&self) -> KinematicNodes {
+        KinematicNodes::None
+    }
+
+    fn compute_forces(&mut self, _ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+        Ok(()) // heat carries no force; thermal stress is the mechanics' (ThermalStrain)
+    }
+
+    fn field_step(&mut self, ctx: &mut FieldContext<'_, D>) -> Result<(), ComputeError> {
+        let d = self.derived.as_mut().expect("init ran");
+        let ids = d.ids.expect("init ran");
+        let (dim, npe) = (D::D, D::NODES_PER_ELEM);
+        let (dt, t0) = (ctx.dt, ctx.time);
+        // Joints that broke since the last step stop conducting: their groups split.
+        if let Some(id) = ids.damage {
+            let damage = ctx.fields.get(id);
+            let mut changed = false;
+            for (b, &dmg) in d.broken.iter_mut().zip(damage) {
+                if !*b && dmg >= 1.0 {
+                    *b = true;
+                    changed = true;
+                }
+            }
+            if changed {
+                let broken = &d.broken;
+                d.groups = Groups::build(ctx.kin.mesh, |j| !broken[j]);
+                d.group_temp = vec![[0.0; 2]; d.groups.len()];
+            }
+        }
+        let conn = ctx.kin.mesh.elements();
+        let [temp, flux, supplied] = ctx.fields.get_many_mut([ids.temp, ids.flux, ids.supplied]);
+        let Derived {
+            geo,
+            material,
+            k,
+            capacity,
+            slot_start,
+            slots,
+            entries,
+            fixed_of,
+            groups,
+            rates,
+            node_rate,
+            node_bnd,
+            group_temp,
+            ..
+        } = d;
+        ctx.backend.install(|| {
+            // Element pass: fluxes and nodal rates per element slot (eq. 95–98).
+            let temps = &*temp;
+            rates
+                .par_chunks_mut(CHUNK * npe)
+                .zip(flux.par_chunks_mut(CHUNK * dim))
+                .enumerate()
+                .for_each(|(c, (r, fl))| {
+                    let first = c * CHUNK;
+                    for (i, (r, fl)) in r
+                        .chunks_exact_mut(npe)
+                        .zip(fl.chunks_exact_mut(dim))
+                        .enumerate()
+                    {
+                        let e = first + i;
+                        let mut t = [0.0; 4];
+                        for (a, &n) in conn[e * npe..(e + 1) * npe].iter().enumerate() {
+                            t[a] = temps[n as usize];
+                        }
+                        conduction::element(
+                            dim,
+                            &geo.grad[e * npe * dim..(e + 1) * npe * dim],
+                            geo.measure[e],
+                            &k[material[e] as usize],
+                            &t[..npe],
+                            fl,
+                            r,
+                        );
+                    }
+                });
+        });
+        // Face conditions at the start of the step.
+        let values: Vec<(f64, f64)> = self
+            .faces
+            .iter()
+            .map(|(_, h)| match h {
+                FaceHeat::Flux(q) => (0.0, q.at(t0)),
+                FaceHeat::Convection(h, te) => (*h, te.at(t0)),
+            })
+            .collect();
+        let rates = &*rates;
+        ctx.backend.install(|| {
+            // Node pass: gather the element slots in a fixed order, add the face heat.
+            node_rate
+                .par_chunks_mut(CHUNK)
+                .zip(node_bnd.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(|(c, (nr, nb))| {
+                    for (i, (nr, nb)) in nr.iter_mut().zip(nb.iter_mut()).enumerate() {
+                        let n = c * CHUNK + i;
+                        let mut s = 0.0;
+                        for &k in &slots[slot_start[n] as usize..slot_start[n + 1] as usize] {
+                            s += rates[k as usize];
+                        }
+                        let mut b = 0.0;
+                        for j in entries.start[n] as usize..entries.start[n + 1] as usize {
+                            let (h, v) = values[entries.cond[j] as usize];
+                            b += entries.share[j] * if h == 0.0 { v } else { h * (v - temp[n]) };
+                        }
+                        *nr = s + b;
+                        *nb = b;
+                    }
+                });
+            // Group pass: one explicit update per thermal node (eq. 94, 99 corrected).
+            let t_end = t0 + dt;
+            let (node_rate, temps) = (&*node_rate, &*temp);
+            group_temp
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(CHUNK)
+                .for_each(|(g, out)| {
+                    let m = &groups.members[groups.start[g] as usize..groups.start[g + 1] as usize];
+                    let (mut r, mut c) = (0.0, 0.0);
+                    let mut fixed = FREE;
+                    for &n in m {
+                        r += node_rate[n as usize];
+                        c += capacity[n as usize];
+                        if fixed_of[n as usize] != FREE {
+                            fixed = fixed_of[n as usize];
+                        }
+                    }
+                    let free = temps[m[0] as usize] + dt * r / c;
+                    let new = if fixed == FREE {
+                        free
+                    } else {
+                        self.fixed[fixed as usize].1.at(t_end)
+                    };
+                    *out = [free, new];
+                });
+            // Node write: temperature and the heat supplied from outside.
+            let group_temp = &*group_temp;
+            temp.par_chunks_mut(CHUNK)
+                .zip(supplied.par_chunks_mut(CHUNK))
+                .enumerate()
+                .for_each(|(c, (tc, sc))| {
+                    for (i, (t, s)) in tc.iter_mut().zip(sc.iter_mut()).enumerate() {
+                        let n = c * CHUNK + i;
+                        let [free, new] = group_temp[groups.of[n] as usize];
+                        *s += dt * node_bnd[n] + capacity[n] * (new - free);
+                        *t = new;
+                    }
+                });
+        });
+        Ok(())
+    }
+}
