@@ -2,7 +2,7 @@
 //!
 //! Facade of the pcdc-rs SDK for continuum–discontinuum geomechanics by the combined
 //! finite–discrete element method (FDEM): re-exports the crates ([`mesh`], [`compute`],
-//! [`mech`], [`cohesive`], [`contact`], [`hydro`]) and composes them: [`fdem::Fdem`] is the
+//! [`mech`], [`cohesive`], [`contact`], [`hydro`], [`thermal`]) and composes them: [`fdem::Fdem`] is the
 //! canonical FDEM composition in one call. The validation scenes, their RESULT lines,
 //! scene files and plots live in the separate crate `pcdc-validation`, so adding `pcdc`
 //! brings the SDK only. The cargo feature `gpu` (on by default) brings the GPU backend.
@@ -43,5 +43,6 @@ pub use pcdc_contact as contact;
 pub use pcdc_hydro as hydro;
 pub use pcdc_mech as mech;
 pub use pcdc_mesh as mesh;
+pub use pcdc_thermal as thermal;
 
 pub mod fdem;
