@@ -3,8 +3,8 @@
 
 use pcdc::compute::Backend;
 use pcdc_validation::scenes::{
-    fracture_flow, injection, kirsch, radial_flow, slope_excavation, unconfined_flow,
-    vibration_energy, wave_speed, Element,
+    fracture_flow, half_space_conduction, injection, kirsch, radial_flow, slope_excavation,
+    thermal_cylinder, unconfined_flow, vibration_energy, wave_speed, Element,
 };
 
 fn cpu() -> Backend {
@@ -424,4 +424,41 @@ fn tunnel_in_mohr_coulomb_rock_follows_salencon() {
         "radius error {}",
         o.radius_error()
     );
+}
+
+/// Transient conduction into a half-space within 2 % of the erfc solution, 2D and 3D,
+/// at the coarsest sizes of the example.
+#[test]
+fn half_space_conduction_within_2_percent_2d_and_3d() {
+    let cpu = cpu();
+    let p2 = half_space_conduction::Params {
+        size: half_space_conduction::SIZES_2D[0],
+    };
+    let o2 = half_space_conduction::run_2d(&cpu, &p2).unwrap();
+    let p3 = half_space_conduction::Params {
+        size: half_space_conduction::SIZES_3D[0],
+    };
+    let o3 = half_space_conduction::run_3d(&cpu, &p3).unwrap();
+    eprintln!(
+        "half-space: 2d error {:.4}, 3d error {:.4}",
+        o2.error, o3.error
+    );
+    assert!(o2.error <= half_space_conduction::TOL, "2d: {}", o2.error);
+    assert!(o3.error <= half_space_conduction::TOL, "3d: {}", o3.error);
+}
+
+/// Scene 13 at its coarsest size: steady T(r) within 2 %, σr and σθ within 5 % of
+/// max |σθ|.
+#[test]
+fn thermal_cylinder_within_tolerance() {
+    let p = thermal_cylinder::Params {
+        size: thermal_cylinder::SIZES[0],
+    };
+    let o = thermal_cylinder::run(&cpu(), &p).unwrap();
+    eprintln!(
+        "thermal cylinder: T error {:.4}, stress error {:.4}, {} steps, schedule {}",
+        o.error_t, o.error_s, o.steps, o.every
+    );
+    assert!(o.error_t <= thermal_cylinder::TOL_T, "T: {}", o.error_t);
+    assert!(o.error_s <= thermal_cylinder::TOL_S, "σ: {}", o.error_s);
 }

@@ -13,8 +13,10 @@ use pcdc_mesh::Dim;
 use crate::physics::{FieldContext, FieldSchedule, SubCycle};
 use crate::{ComputeError, Simulation, StableStep};
 
-/// Largest sub-cycling ratio accepted (beyond it the composition is almost surely
-/// mis-scaled: a field a million times faster or slower than the mechanics).
+/// Largest sub-cycling ratio accepted. A fixed schedule beyond it is refused (almost
+/// surely mis-scaled); [`FieldSchedule::Auto`] caps a slower field at it (heat is often
+/// 1e7 times slower than the mechanics: it then steps at a million mechanical steps,
+/// below its own stable step) and refuses a field that would need more sub-steps.
 pub const MAX_SUBCYCLE: u32 = 1_000_000;
 
 /// The schedule of one physics' field stage.
@@ -68,7 +70,10 @@ impl<D: Dim> Simulation<D> {
                     };
                     let n = ratio.min(MAX_SUBCYCLE as f64 + 1.0) as u32;
                     if dt_f >= self.dt {
-                        SubCycle::Every(n.max(1))
+                        // A slower field than that (heat against mechanics: 1e7 and
+                        // more) steps below its stable step at the cap: safe, and it
+                        // keeps the field moving.
+                        SubCycle::Every(n.clamp(1, MAX_SUBCYCLE))
                     } else {
                         SubCycle::Substeps(n.max(1))
                     }

@@ -49,6 +49,7 @@ type PointFn = Arc<dyn Fn(&[f64]) -> f64 + Send + Sync>;
 enum Initial {
     Uniform(f64),
     Function(PointFn),
+    Nodes(Arc<Vec<f64>>),
 }
 
 /// Heat conduction in the solid with boundary heat (manual 7.6.1–7.6.2, 7.6.8); see the
@@ -231,6 +232,14 @@ impl Thermal {
         f: impl Fn(&[f64]) -> f64 + Send + Sync + 'static,
     ) -> Self {
         self.initial = Initial::Function(Arc::new(f));
+        self
+    }
+
+    /// Initial temperature of every mesh node, in node order (e.g. the
+    /// `names::TEMPERATURE` field of an earlier run on the same mesh); the length must
+    /// equal the node count.
+    pub fn initial_temperature_nodes(mut self, values: Vec<f64>) -> Self {
+        self.initial = Initial::Nodes(Arc::new(values));
         self
     }
 
@@ -450,12 +459,22 @@ impl<D: Dim> Physics<D> for Thermal {
             },
         };
         fields.get_mut(ids.capacity).copy_from_slice(&d.capacity);
+        if let Initial::Nodes(v) = &self.initial {
+            if v.len() != ctx.mesh.n_nodes() {
+                return Err(ComputeError::param(
+                    "initial node temperatures",
+                    v.len(),
+                    format!("must give one value per mesh node ({})", ctx.mesh.n_nodes()),
+                ));
+            }
+        }
         let temp = fields.get_mut(ids.temp);
         for (n, t) in temp.iter_mut().enumerate() {
             let x = ctx.mesh.node(n);
             let v = match &self.initial {
                 Initial::Uniform(t) => *t,
                 Initial::Function(f) => f(x),
+                Initial::Nodes(v) => v[n],
             };
             if !v.is_finite() {
                 return Err(ComputeError::param(
@@ -516,7 +535,9 @@ impl<D: Dim> Physics<D> for Thermal {
         let d = self.derived.as_mut().expect("init ran");
         let ids = d.ids.expect("init ran");
         let (dim, npe) = (D::D, D::NODES_PER_ELEM);
-        let (dt, t0) = (ctx.dt, ctx.time);
+        // Conditions take their values at the end of the mechanical step, every sub-step
+        // alike (the GPU reads them once per step, as the fluid's do).
+        let (dt, t_end) = (ctx.dt, ctx.kin.time);
         // Joints that broke since the last step stop conducting: their groups split.
         if let Some(id) = ids.damage {
             let damage = ctx.fields.get(id);
@@ -582,13 +603,12 @@ impl<D: Dim> Physics<D> for Thermal {
                     }
                 });
         });
-        // Face conditions at the start of the step.
         let values: Vec<(f64, f64)> = self
             .faces
             .iter()
             .map(|(_, h)| match h {
-                FaceHeat::Flux(q) => (0.0, q.at(t0)),
-                FaceHeat::Convection(h, te) => (*h, te.at(t0)),
+                FaceHeat::Flux(q) => (0.0, q.at(t_end)),
+                FaceHeat::Convection(h, te) => (*h, te.at(t_end)),
             })
             .collect();
         let rates = &*rates;
@@ -615,7 +635,6 @@ impl<D: Dim> Physics<D> for Thermal {
                     }
                 });
             // Group pass: one explicit update per thermal node (eq. 94, 99 corrected).
-            let t_end = t0 + dt;
             let (node_rate, temps) = (&*node_rate, &*temp);
             group_temp
                 .par_iter_mut()

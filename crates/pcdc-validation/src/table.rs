@@ -16,8 +16,9 @@ use pcdc_compute::{Backend, BackendKind, Precision};
 use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
-    block_sliding, brazilian, creep, direct_tension, fracture_flow, injection, kirsch, radial_flow,
-    slope_excavation, triaxial, tunnel, ucs, unconfined_flow, vibration_energy, wave_speed,
+    block_sliding, brazilian, creep, direct_tension, fracture_flow, half_space_conduction,
+    injection, kirsch, radial_flow, slope_excavation, thermal_cylinder, triaxial, tunnel, ucs,
+    unconfined_flow, vibration_energy, wave_speed,
 };
 
 /// One measured row of the report.
@@ -129,6 +130,8 @@ pub const CASES: &[&str] = &[
     "creep",
     "tunnel",
     "slope_excavation",
+    "half_space_conduction",
+    "thermal_cylinder",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -273,6 +276,20 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("slope_excavation", "geostatic distorted 10 %", size));
             }
         }
+        "half_space_conduction" => {
+            for (a, b) in half_space_conduction::SIZES_2D
+                .into_iter()
+                .zip(half_space_conduction::SIZES_3D)
+            {
+                out.push(j("half_space_conduction", "2d", a));
+                out.push(j("half_space_conduction", "3d", b));
+            }
+        }
+        "thermal_cylinder" => {
+            for size in thermal_cylinder::SIZES {
+                out.push(j("thermal_cylinder", "T and σ", size));
+            }
+        }
         // Homogeneous blocks: the mesh changes the cost, not the closed form.
         "creep" => {
             for size in [0.05, 0.025, 0.0125] {
@@ -414,6 +431,32 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
                 _ => vibration_energy::run_3d(backend, &p)?,
             };
             within(o.elements, o.drift, vibration_energy::TOL, o.steps)
+        }
+        "half_space_conduction" => {
+            let p = half_space_conduction::Params { size: job.size };
+            let o = if job.variant == "2d" {
+                half_space_conduction::run_2d(backend, &p)?
+            } else {
+                half_space_conduction::run_3d(backend, &p)?
+            };
+            within(o.elements, o.error, half_space_conduction::TOL, o.steps)
+        }
+        "thermal_cylinder" => {
+            let o = thermal_cylinder::run(backend, &thermal_cylinder::Params { size: job.size })?;
+            // The worse of the temperature and stress errors, over its tolerance.
+            let ratio =
+                (o.error_t / thermal_cylinder::TOL_T).max(o.error_s / thermal_cylinder::TOL_S);
+            row(
+                o.elements,
+                ratio,
+                format!(
+                    "1 (T {:.2} % of 2 %, σ {:.2} % of 5 %)",
+                    o.error_t * 100.0,
+                    o.error_s * 100.0
+                ),
+                ratio <= 1.0,
+                o.steps,
+            )
         }
         "slope_excavation" => {
             let p = slope_excavation::Params {
@@ -613,7 +656,9 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
          / h_l of the free surface, elements column counting flow channels, the discharge \
          against Dupuit–Charny in the tolerance column; injection: mass-balance residual, \
          relative, with the fracture's orientation and breakdown pressure in the tolerance \
-         column). Wall time includes the build; \
+         column; half_space_conduction: largest |T − T_erfc| / (Ts − T0) over every node at \
+         two times; thermal_cylinder: the worse of the temperature error / 2 % and the \
+         stress error (σr, σθ against eq. 115–116 corrected, over max |σθ|) / 5 %). Wall time includes the build; \
          element-steps/s = elements × steps / wall time (the direct Kirsch solve counts \
          its iterations as steps). GPU rows on a software adapter (Mesa's lavapipe) \
          show that the path works and what it costs there, not GPU speed.\n\n",
