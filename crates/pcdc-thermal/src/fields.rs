@@ -11,7 +11,7 @@ pub const HEAT_FLUX: FieldKey = FieldKey::new("heat_flux", Place::Element, Compo
 
 /// Heat each node has received from outside the body since the start (J; J/m in 2D):
 /// through face fluxes and convection, and what the temperature conditions put in or
-/// took out to hold their values. With [`crate::Thermal::heat_content`] it closes the
+/// took out to hold their values. With [`crate::heat_content`] it closes the
 /// energy balance: Σ C_l (T_l − T_l⁰) = Σ supplied_l, to rounding.
 pub const HEAT_SUPPLIED: FieldKey =
     FieldKey::new("heat_supplied", Place::Node, Components::Fixed(1));

@@ -48,9 +48,11 @@
 //!
 //! ## Not yet built (issue 17)
 //!
-//! Conduction and advection in the fracture fluid (eq. 102–110), contact conductance
-//! across broken joints (eq. 111–112) and the GPU kernels come next: a GPU simulation
-//! with this physics is refused with `ComputeError::NoGpuKernel`.
+//! Conduction and advection in the fracture fluid (eq. 102–110) and contact conductance
+//! across broken joints (eq. 111–112) come next. On the GPU (kernels in
+//! `shaders/thermal.wgsl`, the CPU's arithmetic in the same order, parity to 1e-12 in
+//! f64) the thermal nodes are fixed for the run: [`JointHeat::FollowDamage`] on a split
+//! mesh is refused there with `ComputeError::NoGpuKernel` (CPU only).
 
 #![warn(missing_docs)]
 #![allow(clippy::needless_range_loop)]
@@ -58,6 +60,7 @@
 mod boundary;
 mod conduction;
 pub mod fields;
+mod gpu;
 mod material;
 mod physics;
 

@@ -2,6 +2,7 @@
 
 use std::sync::Arc;
 
+use pcdc_compute::gpu::GpuSetup;
 use pcdc_compute::names::{JOINT_DAMAGE, TEMPERATURE};
 use pcdc_compute::{
     ComputeError, Entity, EntityKind, FieldContext, FieldId, FieldSchedule, FieldStore, FieldUse,
@@ -18,7 +19,7 @@ use crate::HeatMaterial;
 /// Elements (or nodes) per parallel block.
 const CHUNK: usize = 2048;
 /// No temperature condition on a node.
-const FREE: u32 = u32::MAX;
+pub(crate) const FREE: u32 = u32::MAX;
 
 /// How heat crosses the joints of a split (FDEM) mesh.
 ///
@@ -93,36 +94,36 @@ impl Default for Thermal {
     }
 }
 
-/// What init derives from the mesh.
+/// What init derives from the mesh (read by the GPU program, `crate::gpu`).
 #[derive(Clone, Default)]
-struct Derived {
-    geo: Geometry,
+pub(crate) struct Derived {
+    pub(crate) geo: Geometry,
     /// Material index of each element.
-    material: Vec<u32>,
+    pub(crate) material: Vec<u32>,
     /// k_ij of each material.
-    k: Vec<[[f64; 3]; 3]>,
+    pub(crate) k: Vec<[[f64; 3]; 3]>,
     /// Lumped heat capacity C_l of each node (J/K; J/(m·K) in 2D).
-    capacity: Vec<f64>,
+    pub(crate) capacity: Vec<f64>,
     /// Node → element-rate slots (e · N_e + a), ascending.
-    slot_start: Vec<u32>,
-    slots: Vec<u32>,
-    entries: NodeEntries,
+    pub(crate) slot_start: Vec<u32>,
+    pub(crate) slots: Vec<u32>,
+    pub(crate) entries: NodeEntries,
     /// Temperature condition of each node, or [`FREE`].
-    fixed_of: Vec<u32>,
-    groups: Groups,
+    pub(crate) fixed_of: Vec<u32>,
+    pub(crate) groups: Groups,
     /// Joints that no longer conduct (broken, with [`JointHeat::FollowDamage`]).
-    broken: Vec<bool>,
-    stable: Option<StableStep>,
-    ids: Option<Ids>,
+    pub(crate) broken: Vec<bool>,
+    pub(crate) stable: Option<StableStep>,
+    pub(crate) ids: Option<Ids>,
     // Work arrays.
-    rates: Vec<f64>,
-    node_rate: Vec<f64>,
-    node_bnd: Vec<f64>,
-    group_temp: Vec<[f64; 2]>,
+    pub(crate) rates: Vec<f64>,
+    pub(crate) node_rate: Vec<f64>,
+    pub(crate) node_bnd: Vec<f64>,
+    pub(crate) group_temp: Vec<[f64; 2]>,
 }
 
 #[derive(Clone, Copy)]
-struct Ids {
+pub(crate) struct Ids {
     temp: FieldId,
     flux: FieldId,
     supplied: FieldId,
@@ -133,10 +134,10 @@ struct Ids {
 /// Thermal nodes: the mesh nodes joined through conducting joints (CSR, members
 /// ascending, groups ordered by their first member).
 #[derive(Clone, Debug, Default)]
-struct Groups {
-    of: Vec<u32>,
-    start: Vec<u32>,
-    members: Vec<u32>,
+pub(crate) struct Groups {
+    pub(crate) of: Vec<u32>,
+    pub(crate) start: Vec<u32>,
+    pub(crate) members: Vec<u32>,
 }
 
 impl Groups {
@@ -192,7 +193,7 @@ impl Groups {
         Groups { of, start, members }
     }
 
-    fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.start.len() - 1
     }
 }
@@ -531,6 +532,24 @@ impl<D: Dim> Physics<D> for Thermal {
         Ok(()) // heat carries no force; thermal stress is the mechanics' (ThermalStrain)
     }
 
+    fn gpu_setup(&mut self, setup: &mut GpuSetup<'_, D>) -> Result<(), ComputeError> {
+        let d = self
+            .derived
+            .as_ref()
+            .ok_or_else(|| ComputeError::Gpu("thermal: GPU setup before init".into()))?;
+        if d.ids.and_then(|i| i.damage).is_some() {
+            return Err(ComputeError::NoGpuKernel {
+                physics: "thermal".into(),
+                reason: "joints that stop conducting when they break (JointHeat::FollowDamage \
+                         on a split mesh) need thermal nodes rebuilt during the run, which the \
+                         GPU program does not do yet: use the CPU, or JointHeat::Conducting / \
+                         Insulating"
+                    .into(),
+            });
+        }
+        crate::gpu::program(d, &self.faces, &self.fixed, setup)
+    }
+
     fn field_step(&mut self, ctx: &mut FieldContext<'_, D>) -> Result<(), ComputeError> {
         let d = self.derived.as_mut().expect("init ran");
         let ids = d.ids.expect("init ran");
@@ -603,12 +622,13 @@ impl<D: Dim> Physics<D> for Thermal {
                     }
                 });
         });
-        let values: Vec<(f64, f64)> = self
+        // (convection?, h, value): a flux density, or h and the environment temperature.
+        let values: Vec<(bool, f64, f64)> = self
             .faces
             .iter()
             .map(|(_, h)| match h {
-                FaceHeat::Flux(q) => (0.0, q.at(t_end)),
-                FaceHeat::Convection(h, te) => (*h, te.at(t_end)),
+                FaceHeat::Flux(q) => (false, 0.0, q.at(t_end)),
+                FaceHeat::Convection(h, te) => (true, *h, te.at(t_end)),
             })
             .collect();
         let rates = &*rates;
@@ -627,8 +647,8 @@ impl<D: Dim> Physics<D> for Thermal {
                         }
                         let mut b = 0.0;
                         for j in entries.start[n] as usize..entries.start[n + 1] as usize {
-                            let (h, v) = values[entries.cond[j] as usize];
-                            b += entries.share[j] * if h == 0.0 { v } else { h * (v - temp[n]) };
+                            let (conv, h, v) = values[entries.cond[j] as usize];
+                            b += entries.share[j] * if conv { h * (v - temp[n]) } else { v };
                         }
                         *nr = s + b;
                         *nb = b;

@@ -1,0 +1,215 @@
+//! The GPU kernels of [`crate::Thermal`] (`shaders/thermal.wgsl`), all in the field
+//! phase: the element pass (fluxes, nodal rates per element slot), the node pass (slots
+//! gathered in a fixed order, face conditions), the group pass (one update per thermal
+//! node) and the write pass (temperatures, heat supplied). The same arithmetic in the
+//! same order as the CPU path, no float atomics. Conditions are per-step signals (their
+//! values at the end of the mechanical step, as on the CPU).
+//!
+//! The thermal nodes (groups of split copies joined by conducting joints) are fixed on
+//! the device: [`crate::JointHeat::FollowDamage`] on a split mesh, whose groups split as
+//! joints break, is refused on the GPU (`ComputeError::NoGpuKernel`) until the device
+//! rebuilds them; unsplit meshes, `Conducting` and `Insulating` run.
+
+use pcdc_compute::gpu::{Access, GpuBuffer, GpuData, GpuSetup, Kernel, Phase};
+use pcdc_compute::names::TEMPERATURE;
+use pcdc_compute::ComputeError;
+use pcdc_mesh::Dim;
+
+use crate::boundary::FaceHeat;
+use crate::fields::{HEAT_CAPACITY, HEAT_FLUX, HEAT_SUPPLIED};
+use crate::physics::{Derived, FREE};
+
+/// The WGSL of every kernel: a shared head, then one section per kernel after a
+/// `//!name` line.
+pub(crate) const THERMAL_WGSL: &str = include_str!("shaders/thermal.wgsl");
+
+/// The source of kernel `name`: the shared head and that section.
+pub(crate) fn kernel_source(name: &str) -> String {
+    let head_end = THERMAL_WGSL.find("//!").unwrap_or(THERMAL_WGSL.len());
+    let marker = format!("//!{name}\n");
+    let body = THERMAL_WGSL.find(&marker).map_or("", |at| {
+        let start = at + marker.len();
+        let end = THERMAL_WGSL[start..]
+            .find("//!")
+            .map_or(THERMAL_WGSL.len(), |i| start + i);
+        &THERMAL_WGSL[start..end]
+    });
+    format!("{}{body}", &THERMAL_WGSL[..head_end])
+}
+
+/// Declares the buffers and kernels of the thermal physics (see the module docs).
+pub(crate) fn program<D: Dim>(
+    d: &Derived,
+    faces: &[(pcdc_mesh::Range, FaceHeat)],
+    fixed: &[(pcdc_mesh::Range, pcdc_compute::TimeValue)],
+    setup: &mut GpuSetup<'_, D>,
+) -> Result<(), ComputeError> {
+    let (dim, npe) = (D::D, D::NODES_PER_ELEM);
+    let (ne, nn, ng) = (d.material.len(), d.capacity.len(), d.groups.len());
+    // Conditions as signals: face conditions' value (flux or environment temperature),
+    // temperature conditions' value; the node's condition as its signal index.
+    let mut kind = Vec::with_capacity(faces.len());
+    let mut h = Vec::with_capacity(faces.len());
+    let mut sig = Vec::with_capacity(faces.len());
+    for (_, heat) in faces {
+        let (k, hv, v) = match heat {
+            FaceHeat::Flux(q) => (0u32, 0.0, q.clone()),
+            FaceHeat::Convection(hc, te) => (1u32, *hc, te.clone()),
+        };
+        kind.push(k);
+        h.push(hv);
+        sig.push(setup.signal(move |t, dt| v.at(t + dt)));
+    }
+    let fixed_sig: Vec<u32> = fixed
+        .iter()
+        .map(|(_, v)| {
+            let v = v.clone();
+            setup.signal(move |t, dt| v.at(t + dt))
+        })
+        .collect();
+    let held: Vec<u32> = d
+        .fixed_of
+        .iter()
+        .map(|&c| {
+            if c == FREE {
+                FREE
+            } else {
+                fixed_sig[c as usize]
+            }
+        })
+        .collect();
+    // WGSL arrays may not be empty.
+    let nonempty_u = |v: Vec<u32>| if v.is_empty() { vec![0] } else { v };
+    let nonempty_r = |v: Vec<f64>| if v.is_empty() { vec![0.0] } else { v };
+    let mut k9 = Vec::with_capacity(9 * d.k.len());
+    for k in &d.k {
+        k9.extend(k.iter().flatten());
+    }
+    let up_u = |s: &mut GpuSetup<'_, D>, label: &str, v: Vec<u32>| {
+        s.upload(label, GpuData::U32(nonempty_u(v)))
+    };
+    let up_r = |s: &mut GpuSetup<'_, D>, label: &str, v: Vec<f64>| {
+        s.upload(label, GpuData::Real(nonempty_r(v)))
+    };
+    let conn_data = setup.mesh.elements().to_vec();
+    let conn = up_u(setup, "thermal connectivity", conn_data);
+    let material = up_u(setup, "thermal material", d.material.clone());
+    let kbuf = up_r(setup, "thermal conductivity", k9);
+    let grad = up_r(setup, "thermal gradients", d.geo.grad.clone());
+    let measure = up_r(setup, "thermal measure", d.geo.measure.clone());
+    let rates = up_r(setup, "thermal rates", vec![0.0; ne * npe]);
+    let slot_start = up_u(setup, "thermal slot start", d.slot_start.clone());
+    let slots = up_u(setup, "thermal slots", d.slots.clone());
+    let entry_start = up_u(setup, "thermal entry start", d.entries.start.clone());
+    let entry_cond = up_u(setup, "thermal entry condition", d.entries.cond.clone());
+    let entry_share = up_r(setup, "thermal entry share", d.entries.share.clone());
+    let cond_kind = up_u(setup, "thermal condition kind", kind);
+    let cond_h = up_r(setup, "thermal condition h", h);
+    let cond_sig = up_u(setup, "thermal condition signal", sig);
+    let node_rate = up_r(setup, "thermal node rate", vec![0.0; nn]);
+    let node_bnd = up_r(setup, "thermal node face heat", vec![0.0; nn]);
+    let group_start = up_u(setup, "thermal group start", d.groups.start.clone());
+    let members = up_u(setup, "thermal group members", d.groups.members.clone());
+    let group_of = up_u(setup, "thermal group of node", d.groups.of.clone());
+    let fixed_buf = up_u(setup, "thermal held", held);
+    let group_temp = up_r(setup, "thermal group temperatures", vec![0.0; 2 * ng]);
+    let err = setup.error(|n| {
+        format!("divergence: temperature not finite at node {n}. Hint: the thermal step is above the stable one (a fixed schedule too coarse?)")
+    });
+    let (temp, flux, supplied, capacity, status) = (
+        setup.field(TEMPERATURE)?,
+        setup.field(HEAT_FLUX)?,
+        setup.field(HEAT_SUPPLIED)?,
+        setup.field(HEAT_CAPACITY)?,
+        setup.status(),
+    );
+    let consts = |k: Kernel| -> Kernel {
+        k.const_u32("D", dim as u32)
+            .const_u32("NPE", npe as u32)
+            .const_u32("FREE", FREE)
+            .const_u32("ERR_DIVERGED", err)
+    };
+    let bind = |k: Kernel, names: &[(&str, GpuBuffer, Access)]| -> Kernel {
+        names.iter().fold(k, |k, (n, b, a)| k.bind(n, *b, *a))
+    };
+    use Access::{Read as R, ReadWrite as W};
+    let k = consts(Kernel::new(
+        "thermal elements",
+        kernel_source("element_kernel"),
+        ne,
+    ));
+    let k = bind(
+        k,
+        &[
+            ("th_conn", conn, R),
+            ("th_material", material, R),
+            ("th_k", kbuf, R),
+            ("th_grad", grad, R),
+            ("th_measure", measure, R),
+            ("temperature", temp, R),
+            ("heat_flux", flux, W),
+            ("th_rates", rates, W),
+        ],
+    );
+    setup.kernel(Phase::Field, k)?;
+    let k = consts(Kernel::new(
+        "thermal nodes",
+        kernel_source("node_kernel"),
+        nn,
+    ));
+    let k = bind(
+        k,
+        &[
+            ("th_slot_start", slot_start, R),
+            ("th_slots", slots, R),
+            ("th_rates", rates, R),
+            ("th_entry_start", entry_start, R),
+            ("th_entry_cond", entry_cond, R),
+            ("th_entry_share", entry_share, R),
+            ("th_cond_kind", cond_kind, R),
+            ("th_cond_h", cond_h, R),
+            ("th_cond_signal", cond_sig, R),
+            ("temperature", temp, R),
+            ("th_node_rate", node_rate, W),
+            ("th_node_bnd", node_bnd, W),
+        ],
+    );
+    setup.kernel(Phase::Field, k)?;
+    let k = consts(Kernel::new(
+        "thermal groups",
+        kernel_source("group_kernel"),
+        ng,
+    ));
+    let k = bind(
+        k,
+        &[
+            ("th_group_start", group_start, R),
+            ("th_members", members, R),
+            ("th_node_rate", node_rate, R),
+            ("heat_capacity", capacity, R),
+            ("th_fixed", fixed_buf, R),
+            ("temperature", temp, R),
+            ("th_group_temp", group_temp, W),
+        ],
+    );
+    setup.kernel(Phase::Field, k)?;
+    let k = consts(Kernel::new(
+        "thermal write",
+        kernel_source("write_kernel"),
+        nn,
+    ));
+    let k = bind(
+        k,
+        &[
+            ("th_group_of", group_of, R),
+            ("th_group_temp", group_temp, R),
+            ("th_node_bnd", node_bnd, R),
+            ("heat_capacity", capacity, R),
+            ("heat_supplied", supplied, W),
+            ("temperature", temp, W),
+            ("status", status, W),
+        ],
+    );
+    setup.kernel(Phase::Field, k)?;
+    Ok(())
+}
