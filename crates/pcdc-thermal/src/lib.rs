@@ -62,6 +62,7 @@ mod conduction;
 pub mod fields;
 mod gpu;
 mod material;
+pub mod output;
 mod physics;
 
 pub use fields::{HEAT_CAPACITY, HEAT_FLUX, HEAT_SUPPLIED};

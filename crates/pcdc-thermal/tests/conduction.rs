@@ -252,3 +252,29 @@ proptest! {
         }
     }
 }
+
+/// The output helpers: the energy balance closes, a VTU step with the thermal arrays is
+/// written.
+#[test]
+fn output_writes_vtu_and_balances() {
+    let mesh = builders::rectangle(0.0, 0.0, 0.2, 0.1, 0.05).unwrap();
+    let mut sim = sim_with(
+        mesh,
+        Thermal::new()
+            .material(Range::All, granite())
+            .initial_temperature(20.0)
+            .heat_flux(Range::group("left"), 1e3),
+    )
+    .unwrap();
+    let t0 = sim.field(names::TEMPERATURE).unwrap().to_vec();
+    sim.run(20).unwrap();
+    let b = pcdc_thermal::output::energy_balance(&sim, &t0).unwrap();
+    assert!(b.supplied > 0.0 && b.relative() < 1e-12, "{b:?}");
+    let dir = std::env::temp_dir().join(format!("pcdc_thermal_vtu_{}", std::process::id()));
+    let mut series = pcdc_mesh::vtu::PvdSeries::new(&dir, "heat").unwrap();
+    let path = pcdc_thermal::output::write_step(&sim, &mut series).unwrap();
+    // Binary appended data: the array names are in the XML head.
+    let text = String::from_utf8_lossy(&std::fs::read(&path).unwrap()).into_owned();
+    assert!(text.contains("Name=\"temperature\"") && text.contains("Name=\"heat_flux\""));
+    std::fs::remove_dir_all(&dir).ok();
+}
