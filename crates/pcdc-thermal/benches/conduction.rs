@@ -43,7 +43,7 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.measurement_time(std::time::Duration::from_secs(6));
     let tri = builders::rectangle(0.0, 0.0, 0.05, 0.10, 0.000_224).unwrap();
-    let tet = builders::cuboid([0.0; 3], [0.05, 0.05, 0.10], 0.002_7).unwrap();
+    let tet = builders::cuboid([0.0; 3], [0.05, 0.05, 0.10], 0.002).unwrap();
     let (n2, n3) = (tri.n_nodes(), tet.n_nodes());
     let (e2, e3) = (tri.n_elements() / 1000, tet.n_elements() / 1000);
     for &t in &threads {
