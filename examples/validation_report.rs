@@ -182,7 +182,41 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
-    let mut md = table::markdown(&rows, &machine(&backends));
+    let mut here = machine(&backends);
+    // Rows kept by --resume may come from another machine: name the earlier CPUs.
+    if args.get_flag("resume") {
+        let cpu = |line: &str| {
+            line.split([',', ';'])
+                .next()
+                .unwrap_or("")
+                .trim()
+                .to_string()
+        };
+        let mut earlier: Vec<String> = std::fs::read_to_string("docs/validation.md")
+            .ok()
+            .and_then(|md| {
+                md.lines()
+                    .find_map(|l| l.strip_prefix("Machine: ").map(str::to_string))
+            })
+            .map(|line| {
+                let mut v = vec![cpu(&line)];
+                if let Some(rest) = line.split("earlier rows were measured on: ").nth(1) {
+                    v.extend(rest.trim_end_matches('.').split(" / ").map(str::to_string));
+                }
+                v
+            })
+            .unwrap_or_default();
+        let now = cpu(&here);
+        earlier.retain(|c| !c.is_empty() && *c != now);
+        earlier.dedup();
+        if !earlier.is_empty() {
+            here.push_str(&format!(
+                "; earlier rows were measured on: {}",
+                earlier.join(" / ")
+            ));
+        }
+    }
+    let mut md = table::markdown(&rows, &here);
     if !missing.is_empty() {
         md.push_str(&format!(
             "\nNot measured yet (run the command with `--resume` to add them): {}.\n",
