@@ -282,7 +282,7 @@ impl Thermal {
 
     /// Heat without mechanics: the physics gives every mesh node a unit mass and sets
     /// the step to its own stable step, so a simulation of this physics alone advances
-    /// one thermal step per step. Do not combine with a mechanics.
+    /// one thermal step per step. Composed with a mechanics it is refused at build.
     pub fn heat_only(mut self) -> Self {
         self.heat_only = true;
         self
@@ -446,6 +446,15 @@ impl<D: Dim> Physics<D> for Thermal {
     }
 
     fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
+        // A unit mass per node would corrupt a mechanics' dynamics: refuse the mix.
+        if self.heat_only && ctx.fields.id(pcdc_compute::names::STRESS).is_ok() {
+            return Err(ComputeError::param(
+                "Thermal::heat_only",
+                "with a mechanics",
+                "is for heat alone; with a mechanics leave it out (the heat then sub-cycles \
+                 against the mechanical step)",
+            ));
+        }
         let mut d = self.derive(ctx.mesh)?;
         let fields = &mut *ctx.fields;
         let ids = Ids {

@@ -278,3 +278,18 @@ fn output_writes_vtu_and_balances() {
     assert!(text.contains("Name=\"temperature\"") && text.contains("Name=\"heat_flux\""));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `heat_only` with a mechanics would add unit masses to the mechanics' nodes: refused.
+#[test]
+fn heat_only_with_a_mechanics_is_refused() {
+    let mesh = builders::rectangle(0.0, 0.0, 0.2, 0.1, 0.05).unwrap();
+    let rock = pcdc_mech::LinearElastic::new(30e9, 0.25, 2700.0).unwrap();
+    let err = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+        .physics(pcdc_mech::Mechanics::new().material(Range::All, rock))
+        .physics(Thermal::new().material(Range::All, granite()).heat_only())
+        .build()
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(err.contains("heat_only"), "{err}");
+}
