@@ -188,3 +188,44 @@ return {fname}(e, de, stress, state, c, p + 2u);"
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::LinearElastic;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Around elasticity the wrapper adds exactly −3Kα ΔT I to C:Δε (eq. 113
+        /// corrected), for any strain increment and any temperature path; a free thermal
+        /// expansion (Δε = αΔT I) is stress-free; the last history variable is α(T − T_ref).
+        #[test]
+        fn elastic_thermal_stress_is_minus_3_k_alpha_dt(
+            de in proptest::array::uniform6(-1e-4f64..1e-4),
+            t1 in -50.0f64..400.0,
+            t2 in -50.0f64..400.0,
+            alpha in 1e-7f64..2e-5,
+        ) {
+            let e = LinearElastic::new(30e9, 0.25, 2600.0).unwrap();
+            let m = ThermalStrain::new(e.clone(), alpha, 20.0).unwrap();
+            let (mut s, mut st) = ([0.0; 6], vec![0.0; 1]);
+            m.update_with(&ModelInput::new(&[0.0; 6], &[0.0; 6], &[t1]), &mut s, &mut st);
+            let before = s;
+            m.update_with(&ModelInput::new(&de, &de, &[t2]), &mut s, &mut st);
+            let c = e.stress_of(&de);
+            let th = 3.0 * e.bulk() * alpha * (t2 - t1);
+            let scale = 3.0 * e.bulk() * 1e-2;
+            for k in 0..6 {
+                let expect = before[k] + c[k] - if k < 3 { th } else { 0.0 };
+                prop_assert!((s[k] - expect).abs() <= 1e-9 * scale, "{k}: {} vs {expect}", s[k]);
+            }
+            prop_assert!((st[0] - alpha * (t2 - 20.0)).abs() <= 1e-15);
+            // Free expansion from T_ref: no stress.
+            let (mut s, mut st) = ([0.0; 6], vec![0.0; 1]);
+            let free = alpha * (t2 - 20.0);
+            let f: Sym6 = [free, free, free, 0.0, 0.0, 0.0];
+            m.update_with(&ModelInput::new(&f, &f, &[t2]), &mut s, &mut st);
+            prop_assert!(s.iter().all(|v| v.abs() <= 1e-9 * scale), "{s:?}");
+        }
+    }
+}
