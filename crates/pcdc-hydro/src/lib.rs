@@ -89,6 +89,7 @@ mod model;
 pub mod network;
 pub mod output;
 mod physics;
+mod steady;
 
 pub use balance::{balance_probes, mass_balance, MassBalance};
 pub use model::{saturation_weight, Aperture, FlowModel, Fluid, LeakOff};

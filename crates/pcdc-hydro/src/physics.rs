@@ -19,6 +19,7 @@ use crate::fields::{
 use crate::flow::{self, Geometry};
 use crate::model::{saturation_weight, FlowModel};
 use crate::network::Network;
+use crate::steady;
 
 /// Channels (or flow nodes) per rayon block: many per task, as the engine's loops do.
 const CHUNK: usize = 256;
@@ -158,6 +159,7 @@ pub struct Hydro {
     initial: Initial,
     conditions: Vec<Condition>,
     schedule: FieldSchedule,
+    steady: bool,
     pub(crate) derived: Option<Derived>,
     /// The derivation made for the builder's first questions (sets, fields), kept for
     /// init so that the network is built once: (mesh key, data).
@@ -188,6 +190,7 @@ impl Hydro {
             initial: Initial::Pressure(0.0),
             conditions: Vec::new(),
             schedule: FieldSchedule::Auto,
+            steady: false,
             derived: None,
             prepared: std::sync::OnceLock::new(),
             ids: None,
@@ -333,6 +336,22 @@ impl Hydro {
         self
     }
 
+    /// Steady flow in a rigid network: at build the pressures are solved once for a zero
+    /// net inflow at every free flow node (the explicit steps' discretisation, solved
+    /// by one sparse LU factorisation), and the fluid is not stepped afterwards: pressures, fluxes and
+    /// saturation (1) stay as solved, with no fluid step to limit the simulation's. For a
+    /// slow process carried by a flow that settles quickly, e.g. heat carried along a
+    /// fracture (`pcdc_thermal`'s fluid heat, the Lauwerier scene). Needs
+    /// [`Coupling::FlowOnly`], constant pressure and rate conditions with at least one
+    /// pressure condition in every connected part of the network, no free-surface
+    /// condition and no leak-off (each would make the flow transient); the steady
+    /// pressure must be non-negative everywhere. Runs on both backends (the GPU reads the
+    /// solved fields).
+    pub fn steady_flow(mut self) -> Self {
+        self.steady = true;
+        self
+    }
+
     /// The flow model.
     pub fn model(&self) -> &FlowModel {
         &self.model
@@ -358,6 +377,32 @@ impl Hydro {
 
     fn check(&self) -> Result<(), ComputeError> {
         self.model.check()?;
+        if self.steady {
+            let why = if self.coupling != Coupling::FlowOnly {
+                Some("needs Coupling::FlowOnly (a network that follows the solid changes)")
+            } else if self.model.leak_off.is_some() {
+                Some("cannot leak off (leak-off decays in time)")
+            } else if matches!(self.initial, Initial::Dry) {
+                Some("is saturated: leave out initially_dry")
+            } else if self
+                .conditions
+                .iter()
+                .any(|c| matches!(c, Condition::Head(..)))
+            {
+                Some("takes pressure and rate conditions only (a free surface is found by the transient flow)")
+            } else if self.conditions.iter().any(|c| match c {
+                Condition::Pressure(_, v) | Condition::Rate(_, v) | Condition::Head(_, v) => {
+                    !matches!(v, TimeValue::Const(_))
+                }
+            }) {
+                Some("needs constant conditions (a time table makes the flow transient)")
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                return Err(ComputeError::param("Hydro::steady_flow", "set", why));
+            }
+        }
         if !(self.bulk_scale > 0.0 && self.bulk_scale <= 1.0) {
             return Err(ComputeError::param(
                 "bulk_modulus_scale",
@@ -1015,6 +1060,23 @@ impl<D: Dim> Physics<D> for Hydro {
                 }
             }
         }
+        if self.steady {
+            let fixed: Vec<f64> = d.fixed_values.iter().map(|(_, v)| v.at(0.0)).collect();
+            let rates: Vec<f64> = d.rate_values.iter().map(|v| v.at(0.0)).collect();
+            let inputs = steady::Inputs {
+                fixed_of: &d.fixed,
+                fixed: &fixed,
+                rate_ptr: &d.rate_ptr,
+                rate_cond: &d.rate_cond,
+                rate_share: &d.rate_share,
+                rates: &rates,
+                rho: self.model.fluid.density,
+                mu: self.model.fluid.dynamic_viscosity(),
+            };
+            p0 = steady::pressures(&d.net, &self.geom, &inputs)?;
+            let q = steady::fluxes(&d.net, &self.geom, &p0, D::D, inputs.rho, inputs.mu);
+            ctx.fields.get_mut(ids.flux).copy_from_slice(&q);
+        }
         let vol = &self.geom.node_volume;
         let content: Vec<f64> = (0..nf)
             .map(|l| {
@@ -1060,6 +1122,9 @@ impl<D: Dim> Physics<D> for Hydro {
     }
 
     fn stable_step(&self, kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
+        if self.steady {
+            return None; // solved once, never stepped
+        }
         match self.coupling {
             Coupling::FlowOnly => self.fluid_step(),
             Coupling::OneWay => None,
@@ -1068,10 +1133,13 @@ impl<D: Dim> Physics<D> for Hydro {
     }
 
     fn field_schedule(&self) -> Option<FieldSchedule> {
-        Some(self.schedule)
+        (!self.steady).then_some(self.schedule)
     }
 
     fn field_stable_step(&self, _kin: &Kinematics<'_, D>, _f: &FieldStore) -> Option<StableStep> {
+        if self.steady {
+            return None;
+        }
         self.fluid_step()
     }
 
@@ -1380,6 +1448,9 @@ impl<D: Dim> Physics<D> for Hydro {
         &mut self,
         setup: &mut pcdc_compute::gpu::GpuSetup<'_, D>,
     ) -> Result<(), ComputeError> {
+        if self.steady {
+            return Ok(()); // the solved fields are uploaded with the others; no kernel
+        }
         self.gpu_program(setup)
     }
 
@@ -1390,7 +1461,8 @@ impl<D: Dim> Physics<D> for Hydro {
             .debug(&self.gravity)
             .f64(self.bulk_scale)
             .debug(&self.conditions)
-            .debug(&self.schedule);
+            .debug(&self.schedule)
+            .debug(&self.steady);
         if let Some(d) = &self.derived {
             fp = fp
                 .u32s(&d.net.joint)
