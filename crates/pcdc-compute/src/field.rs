@@ -67,6 +67,36 @@ pub mod names {
     /// input (e.g. thermal strain α ΔT).
     pub const TEMPERATURE: FieldKey =
         FieldKey::new("temperature", Place::Node, Components::Fixed(1));
+    /// The entity set of the flow network's nodes (one per original mesh vertex that a
+    /// permeable joint touches; entity `l` joins one mesh node standing for it, whose
+    /// split copies share it through `Mesh::interfaces().master_of`). Owner: the fluid
+    /// physics (`pcdc-hydro`).
+    pub const FLOW_NODES: &str = "flow_nodes";
+    /// The entity set of the flow network's channels (one per permeable joint; entity
+    /// `c` joins the side-A nodes of its joint, whose masters name its flow nodes).
+    /// Owner: the fluid physics.
+    pub const FLOW_CHANNELS: &str = "flow_channels";
+    /// Saturation s of each flow node (-, in [0, 1]). Owner: the fluid physics.
+    pub const FLOW_SATURATION: FieldKey = FieldKey::new(
+        "flow_saturation",
+        Place::Set(FLOW_NODES),
+        Components::Fixed(1),
+    );
+    /// Hydraulic aperture δ of each channel (m) at the last fluid step. Owner: the fluid
+    /// physics.
+    pub const CHANNEL_APERTURE: FieldKey = FieldKey::new(
+        "channel_aperture",
+        Place::Set(FLOW_CHANNELS),
+        Components::Fixed(1),
+    );
+    /// Mean flux q of each channel (m²/s: volume per unit time and unit width; mean
+    /// velocity q/δ), a vector in global axes in the channel's plane, at the last fluid
+    /// step. Owner: the fluid physics.
+    pub const CHANNEL_FLUX: FieldKey = FieldKey::new(
+        "channel_flux",
+        Place::Set(FLOW_CHANNELS),
+        Components::Vector,
+    );
     /// Node pore (fluid) pressure p (Pa, compression positive), one value per node.
     /// Owner: the fluid physics (the future `pcdc-hydro`). Constitutive and joint models
     /// read it as a coupling input (e.g. effective stress σ' = σ + b p I).
@@ -285,11 +315,14 @@ impl FieldUse {
             Place::Face => (Location::Face, mesh.faces().len()),
             Place::Set(name) => {
                 let set = sets.iter().find(|s| s.name() == name).ok_or_else(|| {
-                    ComputeError::param(
-                        format!("field '{}'", self.name),
-                        name,
-                        "no entity set of that name: the mesh's interfaces are 'joints' (after split_nodes); physics declare theirs with Physics::entity_sets",
-                    )
+                    let reason = if name == names::FLOW_NODES || name == names::FLOW_CHANNELS {
+                        "no composed physics provides the flow network: compose the fluid \
+                         physics (pcdc_hydro::Hydro) in the same simulation"
+                    } else {
+                        "no entity set of that name: the mesh's interfaces are 'joints' (after \
+                         split_nodes); physics declare theirs with Physics::entity_sets"
+                    };
+                    ComputeError::param(format!("field '{}'", self.name), name, reason)
                 })?;
                 (Location::Entities(set.len()), set.len())
             }

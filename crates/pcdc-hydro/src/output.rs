@@ -70,6 +70,19 @@ impl NetworkSeries {
 
     /// Writes the network's current state as the next step of the series.
     pub fn write_step<D: Dim>(&mut self, sim: &Simulation<D>) -> Result<(), ComputeError> {
+        self.write_step_with(sim, &[], &[])
+    }
+
+    /// [`NetworkSeries::write_step`] with more arrays on the flow nodes (`points`) and
+    /// channels (`cells`) from other physics, e.g. the fluid temperature of
+    /// `pcdc_thermal::output::fluid_point_arrays`.
+    pub fn write_step_with<D: Dim>(
+        &mut self,
+        sim: &Simulation<D>,
+        points: &[DataArray<'_>],
+        cells: &[DataArray<'_>],
+    ) -> Result<(), ComputeError> {
+        let (extra_points, extra_cells) = (points, cells);
         let (points, conn) = network_cells(sim)?;
         let cells = Cells {
             points: &points,
@@ -84,37 +97,41 @@ impl NetworkSeries {
         let w: Vec<f64> = dw.iter().enumerate().map(|(l, x)| bal[4 * l] + x).collect();
         let a = sim.field(CHANNEL_APERTURE)?;
         let q = sim.field(CHANNEL_FLUX)?;
+        let mut point_arrays = vec![
+            DataArray::Scalar {
+                name: "pressure",
+                values: p,
+            },
+            DataArray::Scalar {
+                name: "peak_pressure",
+                values: peak,
+            },
+            DataArray::Scalar {
+                name: "saturation",
+                values: s,
+            },
+            DataArray::Scalar {
+                name: "content",
+                values: &w,
+            },
+        ];
+        point_arrays.extend_from_slice(extra_points);
+        let mut cell_arrays = vec![
+            DataArray::Scalar {
+                name: "aperture",
+                values: a,
+            },
+            DataArray::Vector {
+                name: "flux",
+                values: q,
+            },
+        ];
+        cell_arrays.extend_from_slice(extra_cells);
         self.series.write_cells_step::<D>(
             sim.kinematics().time,
             &cells,
-            &[
-                DataArray::Scalar {
-                    name: "pressure",
-                    values: p,
-                },
-                DataArray::Scalar {
-                    name: "peak_pressure",
-                    values: peak,
-                },
-                DataArray::Scalar {
-                    name: "saturation",
-                    values: s,
-                },
-                DataArray::Scalar {
-                    name: "content",
-                    values: &w,
-                },
-            ],
-            &[
-                DataArray::Scalar {
-                    name: "aperture",
-                    values: a,
-                },
-                DataArray::Vector {
-                    name: "flux",
-                    values: q,
-                },
-            ],
+            &point_arrays,
+            &cell_arrays,
         )?;
         Ok(())
     }

@@ -20,3 +20,31 @@ pub const HEAT_SUPPLIED: FieldKey =
 /// eq. 94), written once at init: Σ_l C_l T_l is the heat content.
 pub const HEAT_CAPACITY: FieldKey =
     FieldKey::new("heat_capacity", Place::Node, Components::Fixed(1));
+
+/// Temperature of each flow node's fluid (K or °C), with
+/// [`crate::Thermal::fluid`] (entity set [`pcdc_compute::names::FLOW_NODES`] of the
+/// fluid physics).
+pub const FLUID_TEMPERATURE: FieldKey = FieldKey::new(
+    "fluid_temperature",
+    Place::Set(pcdc_compute::names::FLOW_NODES),
+    Components::Fixed(1),
+);
+
+/// Heat capacity of each flow node's fluid at the last thermal step,
+/// C_l = ρ_f C_f s_l V_l (J/K; J/(m·K) in 2D): Σ_l C_l T_l is the fluid's heat content.
+pub const FLUID_HEAT_CAPACITY: FieldKey = FieldKey::new(
+    "fluid_heat_capacity",
+    Place::Set(pcdc_compute::names::FLOW_NODES),
+    Components::Fixed(1),
+);
+
+/// Heat balance of each flow node's fluid (J; J/m in 2D), 4 per node: the heat content
+/// C⁰T⁰ at the start, the heat the fluid temperature conditions put in to hold their
+/// values, the advected heat (summed over the network: what the flow carried across
+/// its boundary and into storage), and T ΔC as the fluid volume changed. With the
+/// solid's it closes the energy balance (`crate::output::energy_balance`).
+pub const FLUID_HEAT_BALANCE: FieldKey = FieldKey::new(
+    "fluid_heat_balance",
+    Place::Set(pcdc_compute::names::FLOW_NODES),
+    Components::Fixed(4),
+);

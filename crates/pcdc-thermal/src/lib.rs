@@ -60,12 +60,17 @@
 mod boundary;
 mod conduction;
 pub mod fields;
+mod fluid;
 mod gpu;
 mod material;
 pub mod output;
 mod physics;
 
-pub use fields::{HEAT_CAPACITY, HEAT_FLUX, HEAT_SUPPLIED};
+pub use fields::{
+    FLUID_HEAT_BALANCE, FLUID_HEAT_CAPACITY, FLUID_TEMPERATURE, HEAT_CAPACITY, HEAT_FLUX,
+    HEAT_SUPPLIED,
+};
+pub use fluid::FluidHeat;
 pub use material::{Conductivity, HeatMaterial};
 pub use physics::{JointHeat, Thermal};
 

@@ -12,7 +12,10 @@ use pcdc_compute::{names, ComputeError, Simulation};
 use pcdc_mesh::vtu::{DataArray, PvdSeries};
 use pcdc_mesh::Dim;
 
-use crate::{heat_content, HEAT_CAPACITY, HEAT_FLUX, HEAT_SUPPLIED};
+use crate::{
+    heat_content, FLUID_HEAT_BALANCE, FLUID_HEAT_CAPACITY, FLUID_TEMPERATURE, HEAT_CAPACITY,
+    HEAT_FLUX, HEAT_SUPPLIED,
+};
 
 /// The energy balance of the heat since the start (J; J/m in 2D):
 /// Σ C_l (T_l − T_l⁰) against Σ supplied_l.
@@ -38,7 +41,8 @@ impl EnergyBalance {
 
 /// The balance of a simulation with the thermal physics, against the temperatures
 /// `initial` it started from (node order: keep a copy of the `temperature` field after
-/// the build).
+/// the build). With fluid heat ([`crate::Thermal::fluid`]) the fluid's heat content
+/// and [`FLUID_HEAT_BALANCE`] are included (the fluid's start is kept in that field).
 pub fn energy_balance<D: Dim>(
     sim: &Simulation<D>,
     initial: &[f64],
@@ -52,10 +56,17 @@ pub fn energy_balance<D: Dim>(
             format!("must give one value per node ({})", t.len()),
         ));
     }
-    Ok(EnergyBalance {
-        stored: heat_content(cap, t) - heat_content(cap, initial),
-        supplied: sim.field(HEAT_SUPPLIED)?.iter().sum(),
-    })
+    let mut stored = heat_content(cap, t) - heat_content(cap, initial);
+    let mut supplied: f64 = sim.field(HEAT_SUPPLIED)?.iter().sum();
+    if let Ok(tf) = sim.field(FLUID_TEMPERATURE) {
+        let bal = sim.field(FLUID_HEAT_BALANCE)?;
+        stored += heat_content(sim.field(FLUID_HEAT_CAPACITY)?, tf);
+        for b in bal.chunks_exact(4) {
+            stored -= b[0];
+            supplied += b[1] + b[2] + b[3];
+        }
+    }
+    Ok(EnergyBalance { stored, supplied })
 }
 
 /// The node arrays: `temperature` (K or °C) and `heat_supplied` (J).
@@ -70,6 +81,15 @@ pub fn point_arrays<D: Dim>(sim: &Simulation<D>) -> Result<[DataArray<'_>; 2], C
             values: sim.field(HEAT_SUPPLIED)?,
         },
     ])
+}
+
+/// The flow-node array `fluid_temperature` (K or °C), for
+/// `pcdc_hydro::output::NetworkSeries::write_step_with`.
+pub fn fluid_point_arrays<D: Dim>(sim: &Simulation<D>) -> Result<[DataArray<'_>; 1], ComputeError> {
+    Ok([DataArray::Scalar {
+        name: "fluid_temperature",
+        values: sim.field(FLUID_TEMPERATURE)?,
+    }])
 }
 
 /// The element array: `heat_flux` (W/m², vector).

@@ -13,8 +13,15 @@ use rayon::prelude::*;
 
 use crate::boundary::{self, FaceHeat, NodeEntries};
 use crate::conduction::{self, Geometry};
-use crate::fields::{HEAT_CAPACITY, HEAT_FLUX, HEAT_SUPPLIED};
+use crate::fields::{
+    FLUID_HEAT_BALANCE, FLUID_HEAT_CAPACITY, FLUID_TEMPERATURE, HEAT_CAPACITY, HEAT_FLUX,
+    HEAT_SUPPLIED,
+};
+use crate::fluid::{self, FluidHeat};
 use crate::HeatMaterial;
+use pcdc_compute::names::{
+    CHANNEL_APERTURE, CHANNEL_FLUX, FLOW_CHANNELS, FLOW_NODES, FLOW_SATURATION,
+};
 
 /// Elements (or nodes) per parallel block.
 const CHUNK: usize = 2048;
@@ -85,6 +92,9 @@ pub struct Thermal {
     joints: JointHeat,
     schedule: FieldSchedule,
     heat_only: bool,
+    fluid: Option<FluidHeat>,
+    fluid_fixed: Vec<(Range, TimeValue)>,
+    fluid_initial: Option<f64>,
     derived: Option<Derived>,
 }
 
@@ -114,12 +124,36 @@ pub(crate) struct Derived {
     /// Joints that no longer conduct (broken, with [`JointHeat::FollowDamage`]).
     pub(crate) broken: Vec<bool>,
     pub(crate) stable: Option<StableStep>,
+    /// Gershgorin row sums Σ_b |K_lb| of each node (convection included), W/K.
+    rows: Vec<f64>,
     pub(crate) ids: Option<Ids>,
+    pub(crate) fluid: Option<FluidState>,
     // Work arrays.
     pub(crate) rates: Vec<f64>,
     pub(crate) node_rate: Vec<f64>,
     pub(crate) node_bnd: Vec<f64>,
     pub(crate) group_temp: Vec<[f64; 2]>,
+}
+
+/// The fluid heat's network, field ids and work arrays.
+#[derive(Clone)]
+pub(crate) struct FluidState {
+    pub(crate) net: fluid::Net,
+    ids: FluidIds,
+    slots: Vec<fluid::Slot>,
+    /// The fluid temperatures after the fluid update of the current step.
+    t_new: Vec<f64>,
+    scratch: Vec<f64>,
+}
+
+#[derive(Clone, Copy)]
+struct FluidIds {
+    temp: FieldId,
+    capacity: FieldId,
+    balance: FieldId,
+    saturation: FieldId,
+    aperture: FieldId,
+    flux: FieldId,
 }
 
 #[derive(Clone, Copy)]
@@ -210,6 +244,9 @@ impl Thermal {
             joints: JointHeat::default(),
             schedule: FieldSchedule::Auto,
             heat_only: false,
+            fluid: None,
+            fluid_fixed: Vec::new(),
+            fluid_initial: None,
             derived: None,
         }
     }
@@ -286,6 +323,144 @@ impl Thermal {
     pub fn heat_only(mut self) -> Self {
         self.heat_only = true;
         self
+    }
+
+    /// Heat in the fracture fluid of the flow network (eq. 102–110; see the `fluid`
+    /// section of the crate docs): conduction along the channels, upwind advection with
+    /// their fluxes, exchange with the channel walls. Needs the fluid physics
+    /// (`pcdc_hydro::Hydro`) composed in the same simulation; CPU only for now.
+    pub fn fluid(mut self, fluid: FluidHeat) -> Self {
+        self.fluid = Some(fluid);
+        self
+    }
+
+    /// Holds the fluid of the flow nodes whose vertices lie in `range` at temperature
+    /// `t` (constant or time table; manual table 15), e.g. the fluid entering at an
+    /// injection node. Needs [`Thermal::fluid`]; the last condition wins.
+    pub fn fluid_temperature(mut self, range: Range, t: impl Into<TimeValue>) -> Self {
+        self.fluid_fixed.push((range, t.into()));
+        self
+    }
+
+    /// Uniform initial fluid temperature (K or °C). By default each flow node's fluid
+    /// starts at the initial temperature of the solid node standing for it.
+    pub fn initial_fluid_temperature(mut self, t: f64) -> Self {
+        self.fluid_initial = Some(t);
+        self
+    }
+
+    /// The fluid heat's network, initial state and stable steps (init).
+    fn init_fluid<D: Dim>(
+        &self,
+        fl: &FluidHeat,
+        ctx: &mut InitContext<'_, D>,
+        d: &mut Derived,
+    ) -> Result<FluidState, ComputeError> {
+        let (Some(nodes), Some(channels)) =
+            (ctx.entity_set(FLOW_NODES), ctx.entity_set(FLOW_CHANNELS))
+        else {
+            return Err(ComputeError::param(
+                "Thermal::fluid",
+                "no flow network",
+                "heat in the fracture fluid needs the flow network: compose the fluid physics \
+                 (pcdc_hydro::Hydro) in the same simulation",
+            ));
+        };
+        let net = fluid::network(ctx.mesh, nodes, channels, &self.fluid_fixed)?;
+        let fields = &mut *ctx.fields;
+        let ids = FluidIds {
+            temp: fields.id(FLUID_TEMPERATURE)?,
+            capacity: fields.id(FLUID_HEAT_CAPACITY)?,
+            balance: fields.id(FLUID_HEAT_BALANCE)?,
+            saturation: fields.id(FLOW_SATURATION)?,
+            aperture: fields.id(CHANNEL_APERTURE)?,
+            flux: fields.id(CHANNEL_FLUX)?,
+        };
+        // The reference configuration, as the fluid physics' init uses.
+        let coords = ctx.mesh.coords().to_vec();
+        let zeros = vec![0.0; coords.len()];
+        let mass = vec![1.0; ctx.mesh.n_nodes()];
+        let kin = Kinematics {
+            mesh: ctx.mesh,
+            coords: &coords,
+            mass: &mass,
+            u: &zeros,
+            v: &zeros,
+            time: 0.0,
+            dt: 0.0,
+            step: 0,
+            damping: false,
+        };
+        // Stable steps: the walls' exchange joins the solid rows; the fluid's conduction.
+        let walls = fluid::wall_rows(fl, &net, &kin);
+        for (r, w) in d.rows.iter_mut().zip(&walls) {
+            *r += w;
+        }
+        d.stable = solid_stable(&d.capacity, &d.rows);
+        if let Some(f) = fluid::stable_step(fl, &net, &kin) {
+            if d.stable.as_ref().is_none_or(|s| f.dt < s.dt) {
+                d.stable = Some(f);
+            }
+        }
+        // Initial temperatures and heat content.
+        let solid = fields.get(d.ids.expect("set").temp).to_vec();
+        let nf = net.n_nodes();
+        let npc = net.npc;
+        let mut vol = vec![0.0; nf];
+        {
+            let aperture = fields.get(ids.aperture);
+            for c in 0..net.n_channels() {
+                let mut m = [[0.0; 3]; 3];
+                for k in 0..npc {
+                    let (a, b) = (
+                        net.walls[c * 2 * npc + k] as usize,
+                        net.walls[c * 2 * npc + npc + k] as usize,
+                    );
+                    for q in 0..D::D {
+                        m[k][q] = 0.5 * (coords[a * D::D + q] + coords[b * D::D + q]);
+                    }
+                }
+                let g = fluid::channel_geometry(npc, &m, [0.0; 3]);
+                for k in 0..npc {
+                    vol[net.channel_nodes[c * npc + k] as usize] +=
+                        aperture[c] * g.measure / npc as f64;
+                }
+            }
+        }
+        let sat = fields.get(ids.saturation).to_vec();
+        let t0: Vec<f64> = (0..nf)
+            .map(|l| match net.fixed_of[l] {
+                FREE => self
+                    .fluid_initial
+                    .unwrap_or(solid[net.node_rep[l] as usize]),
+                f => self.fluid_fixed[f as usize].1.at(0.0),
+            })
+            .collect();
+        if let Some(t) = self.fluid_initial {
+            if !t.is_finite() {
+                return Err(ComputeError::param(
+                    "initial fluid temperature",
+                    t,
+                    "must be finite",
+                ));
+            }
+        }
+        let c0: Vec<f64> = (0..nf)
+            .map(|l| fl.volumetric_capacity() * sat[l].clamp(0.0, 1.0) * vol[l])
+            .collect();
+        fields.get_mut(ids.temp).copy_from_slice(&t0);
+        fields.get_mut(ids.capacity).copy_from_slice(&c0);
+        let bal = fields.get_mut(ids.balance);
+        for l in 0..nf {
+            bal[l * 4] = c0[l] * t0[l];
+        }
+        Ok(FluidState {
+            slots: vec![fluid::Slot::default(); net.n_channels() * npc],
+            t_new: t0,
+            scratch: Vec::new(),
+            net,
+            ids,
+        })
     }
 
     fn reads_damage<D: Dim>(&self, mesh: &Mesh<D>) -> bool {
@@ -397,15 +572,7 @@ impl Thermal {
                 }
             }
         }
-        let stable = (0..nn)
-            .filter(|&n| rows[n] > 0.0)
-            .map(|n| (2.0 * capacity[n] / rows[n], n))
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map(|(dt, n)| StableStep {
-                dt,
-                entity: Entity::new(EntityKind::Node, n),
-                physics: "thermal".into(),
-            });
+        let stable = solid_stable(&capacity, &rows);
         Ok(Derived {
             rates: vec![0.0; ne * npe],
             node_rate: vec![0.0; nn],
@@ -422,9 +589,24 @@ impl Thermal {
             groups,
             broken,
             stable,
+            rows,
             ids: None,
+            fluid: None,
         })
     }
+}
+
+/// The solid's stable step 2 C_l / Σ|K_lb| over the nodes, with the limiting node.
+fn solid_stable(capacity: &[f64], rows: &[f64]) -> Option<StableStep> {
+    (0..capacity.len())
+        .filter(|&n| rows[n] > 0.0)
+        .map(|n| (2.0 * capacity[n] / rows[n], n))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(dt, n)| StableStep {
+            dt,
+            entity: Entity::new(EntityKind::Node, n),
+            physics: "thermal".into(),
+        })
 }
 
 impl<D: Dim> Physics<D> for Thermal {
@@ -441,6 +623,16 @@ impl<D: Dim> Physics<D> for Thermal {
         ];
         if self.reads_damage(mesh) {
             f.push(JOINT_DAMAGE.read_lagged::<D>());
+        }
+        if self.fluid.is_some() {
+            f.extend([
+                FLUID_TEMPERATURE.own::<D>(),
+                FLUID_HEAT_CAPACITY.own::<D>(),
+                FLUID_HEAT_BALANCE.own::<D>(),
+                FLOW_SATURATION.read_lagged::<D>(),
+                CHANNEL_APERTURE.read_lagged::<D>(),
+                CHANNEL_FLUX.read_lagged::<D>(),
+            ]);
         }
         f
     }
@@ -499,6 +691,15 @@ impl<D: Dim> Physics<D> for Thermal {
             };
         }
         d.ids = Some(ids);
+        if let Some(fl) = &self.fluid {
+            d.fluid = Some(self.init_fluid(fl, ctx, &mut d)?);
+        } else if !self.fluid_fixed.is_empty() || self.fluid_initial.is_some() {
+            return Err(ComputeError::param(
+                "fluid temperature",
+                "without fluid heat",
+                "fluid temperatures need Thermal::fluid (and a flow network)",
+            ));
+        }
         self.derived = Some(d);
         Ok(())
     }
@@ -546,6 +747,14 @@ impl<D: Dim> Physics<D> for Thermal {
             .derived
             .as_ref()
             .ok_or_else(|| ComputeError::Gpu("thermal: GPU setup before init".into()))?;
+        if d.fluid.is_some() {
+            return Err(ComputeError::NoGpuKernel {
+                physics: "thermal".into(),
+                reason: "heat in the fracture fluid (Thermal::fluid) runs on the CPU only for \
+                         now"
+                .into(),
+            });
+        }
         if d.ids.and_then(|i| i.damage).is_some() {
             return Err(ComputeError::NoGpuKernel {
                 physics: "thermal".into(),
@@ -582,6 +791,39 @@ impl<D: Dim> Physics<D> for Thermal {
                 d.group_temp = vec![[0.0; 2]; d.groups.len()];
             }
         }
+        // The fracture fluid first, against the solid at the start of the step; the walls
+        // then take the exchange at the fluid's new temperatures (fluid module docs).
+        if let (Some(fs), Some(fl)) = (d.fluid.as_mut(), self.fluid.as_ref()) {
+            let fi = fs.ids;
+            let [temp, tf, cap, bal, s, ap, q] = ctx.fields.get_many_mut([
+                ids.temp,
+                fi.temp,
+                fi.capacity,
+                fi.balance,
+                fi.saturation,
+                fi.aperture,
+                fi.flux,
+            ]);
+            ctx.backend.install(|| {
+                fluid::step(
+                    fl,
+                    &fs.net,
+                    &self.fluid_fixed,
+                    &ctx.kin,
+                    dt,
+                    t_end,
+                    temp,
+                    (s, ap, q),
+                    tf,
+                    cap,
+                    bal,
+                    &mut fs.slots,
+                    &mut fs.scratch,
+                )
+            });
+            fs.t_new.copy_from_slice(tf);
+        }
+        let fluid_state = d.fluid.as_ref();
         let conn = ctx.kin.mesh.elements();
         let [temp, flux, supplied] = ctx.fields.get_many_mut([ids.temp, ids.flux, ids.supplied]);
         let Derived {
@@ -658,6 +900,9 @@ impl<D: Dim> Physics<D> for Thermal {
                         for j in entries.start[n] as usize..entries.start[n + 1] as usize {
                             let (conv, h, v) = values[entries.cond[j] as usize];
                             b += entries.share[j] * if conv { h * (v - temp[n]) } else { v };
+                        }
+                        if let Some(fs) = fluid_state {
+                            s += fluid::wall_rate(&fs.net, &fs.slots, &fs.t_new, temp, n);
                         }
                         *nr = s + b;
                         *nb = b;
