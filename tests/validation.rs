@@ -3,8 +3,8 @@
 
 use pcdc::compute::Backend;
 use pcdc_validation::scenes::{
-    fracture_flow, half_space_conduction, injection, kirsch, radial_flow, slope_excavation,
-    thermal_cylinder, unconfined_flow, vibration_energy, wave_speed, Element,
+    fracture_flow, half_space_conduction, injection, kirsch, lauwerier, radial_flow,
+    slope_excavation, thermal_cylinder, unconfined_flow, vibration_energy, wave_speed, Element,
 };
 
 fn cpu() -> Backend {
@@ -461,4 +461,20 @@ fn thermal_cylinder_within_tolerance() {
     );
     assert!(o.error_t <= thermal_cylinder::TOL_T, "T: {}", o.error_t);
     assert!(o.error_s <= thermal_cylinder::TOL_S, "σ: {}", o.error_s);
+}
+
+/// Scene 14 (Lauwerier) at its coarsest size: fluid along the fracture and rock 5 m
+/// away within 5 % of T_a − T_i at 50 and 150 days.
+#[test]
+fn lauwerier_within_5_percent() {
+    let p = lauwerier::Params {
+        size: lauwerier::SIZES[0],
+    };
+    let o = lauwerier::run(&cpu(), &p).unwrap();
+    eprintln!(
+        "lauwerier: fluid {:.4}, rock {:.4}, v {:.4e} m/s, {} steps",
+        o.error_fluid, o.error_rock, o.velocity, o.steps
+    );
+    assert!((o.velocity - lauwerier::VELOCITY).abs() < 1e-9 * lauwerier::VELOCITY);
+    assert!(o.error <= lauwerier::TOL, "error {}", o.error);
 }

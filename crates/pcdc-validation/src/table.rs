@@ -17,8 +17,8 @@ use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
     block_sliding, brazilian, creep, direct_tension, fracture_flow, half_space_conduction,
-    injection, kirsch, radial_flow, slope_excavation, thermal_cylinder, triaxial, tunnel, ucs,
-    unconfined_flow, vibration_energy, wave_speed,
+    injection, kirsch, lauwerier, radial_flow, slope_excavation, thermal_cylinder, triaxial,
+    tunnel, ucs, unconfined_flow, vibration_energy, wave_speed,
 };
 
 /// One measured row of the report.
@@ -132,6 +132,7 @@ pub const CASES: &[&str] = &[
     "slope_excavation",
     "half_space_conduction",
     "thermal_cylinder",
+    "lauwerier",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -290,6 +291,11 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("thermal_cylinder", "T and σ", size));
             }
         }
+        "lauwerier" => {
+            for size in lauwerier::SIZES {
+                out.push(j("lauwerier", "fluid and rock", size));
+            }
+        }
         // Homogeneous blocks: the mesh changes the cost, not the closed form.
         "creep" => {
             for size in [0.05, 0.025, 0.0125] {
@@ -440,6 +446,10 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
                 half_space_conduction::run_3d(backend, &p)?
             };
             within(o.elements, o.error, half_space_conduction::TOL, o.steps)
+        }
+        "lauwerier" => {
+            let o = lauwerier::run(backend, &lauwerier::Params { size: job.size })?;
+            within(o.elements, o.error, lauwerier::TOL, o.steps)
         }
         "thermal_cylinder" => {
             let o = thermal_cylinder::run(backend, &thermal_cylinder::Params { size: job.size })?;

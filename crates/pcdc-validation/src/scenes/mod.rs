@@ -20,6 +20,7 @@ pub mod fragmentation;
 pub mod half_space_conduction;
 pub mod injection;
 pub mod kirsch;
+pub mod lauwerier;
 pub mod limits;
 pub mod platen_test;
 pub mod radial_flow;
