@@ -3,7 +3,9 @@
 //! gathered in a fixed order, face conditions), the group pass (one update per thermal
 //! node) and the write pass (temperatures, heat supplied). The same arithmetic in the
 //! same order as the CPU path, no float atomics. Conditions are per-step signals (their
-//! values at the end of the mechanical step, as on the CPU).
+//! values at the end of the mechanical step, as on the CPU). With fluid heat, the fluid
+//! channel and node passes run before the node pass (against the solid at the start of
+//! the step) and a wall pass after it adds the exchange at the fluid's new temperatures.
 //!
 //! The thermal nodes (groups of split copies joined by conducting joints) are fixed on
 //! the device: [`crate::JointHeat::FollowDamage`] on a split mesh, whose groups split as
@@ -16,8 +18,11 @@ use pcdc_compute::ComputeError;
 use pcdc_mesh::Dim;
 
 use crate::boundary::FaceHeat;
+use crate::fields::{FLUID_HEAT_BALANCE, FLUID_HEAT_CAPACITY, FLUID_TEMPERATURE};
 use crate::fields::{HEAT_CAPACITY, HEAT_FLUX, HEAT_SUPPLIED};
 use crate::physics::{Derived, FREE};
+use crate::FluidHeat;
+use pcdc_compute::names::{CHANNEL_APERTURE, CHANNEL_FLUX, FLOW_SATURATION};
 
 /// The WGSL of every kernel: a shared head, then one section per kernel after a
 /// `//!name` line.
@@ -42,6 +47,7 @@ pub(crate) fn program<D: Dim>(
     d: &Derived,
     faces: &[(pcdc_mesh::Range, FaceHeat)],
     fixed: &[(pcdc_mesh::Range, pcdc_compute::TimeValue)],
+    fluid: Option<(&FluidHeat, &[(pcdc_mesh::Range, pcdc_compute::TimeValue)])>,
     setup: &mut GpuSetup<'_, D>,
 ) -> Result<(), ComputeError> {
     let (dim, npe) = (D::D, D::NODES_PER_ELEM);
@@ -152,6 +158,106 @@ pub(crate) fn program<D: Dim>(
         ],
     );
     setup.kernel(Phase::Field, k)?;
+    // The fracture fluid against the solid at the start of the step (fluid module).
+    let fluid_prog = match (fluid, d.fluid.as_ref()) {
+        (Some((fl, fl_fixed)), Some(fs)) => {
+            let net = &fs.net;
+            let fixed_sig: Vec<u32> = fl_fixed
+                .iter()
+                .map(|(_, v)| {
+                    let v = v.clone();
+                    setup.signal(move |t, dt| v.at(t + dt))
+                })
+                .collect();
+            let held: Vec<u32> = net
+                .fixed_of
+                .iter()
+                .map(|&c| {
+                    if c == FREE {
+                        FREE
+                    } else {
+                        fixed_sig[c as usize]
+                    }
+                })
+                .collect();
+            let npc = net.npc;
+            let b = FluidBuffers {
+                channel_nodes: up_u(setup, "fluid heat channel nodes", net.channel_nodes.clone()),
+                walls: up_u(setup, "fluid heat walls", net.walls.clone()),
+                inc_ptr: up_u(setup, "fluid heat incidence ptr", net.inc_ptr.clone()),
+                incidence: up_u(setup, "fluid heat incidence", net.incidence.clone()),
+                wall_ptr: up_u(setup, "fluid heat wall ptr", net.wall_ptr.clone()),
+                wall_slots: up_u(setup, "fluid heat wall slots", net.wall_slots.clone()),
+                fixed: up_u(setup, "fluid heat held", held),
+                slots: up_r(
+                    setup,
+                    "fluid heat slots",
+                    vec![0.0; net.n_channels() * npc * 5],
+                ),
+            };
+            let (rc, kf, hsf) = (fl.volumetric_capacity(), fl.conductivity(), fl.transfer());
+            let fconsts = move |k: Kernel| -> Kernel {
+                consts(k)
+                    .const_u32("NPC", npc as u32)
+                    .const_real("RC", rc)
+                    .const_real("KF", kf)
+                    .const_real("HSF", hsf)
+            };
+            let (tf, cap, bal, sat, ap, q) = (
+                setup.field(FLUID_TEMPERATURE)?,
+                setup.field(FLUID_HEAT_CAPACITY)?,
+                setup.field(FLUID_HEAT_BALANCE)?,
+                setup.field(FLOW_SATURATION)?,
+                setup.field(CHANNEL_APERTURE)?,
+                setup.field(CHANNEL_FLUX)?,
+            );
+            let (coords, disp) = (setup.coords(), setup.displacement());
+            let k = fconsts(Kernel::new(
+                "thermal fluid channels",
+                kernel_source("fluid_channel_kernel"),
+                net.n_channels(),
+            ));
+            let k = bind(
+                k,
+                &[
+                    ("coords", coords, R),
+                    ("disp", disp, R),
+                    ("fl_walls", b.walls, R),
+                    ("fl_channel_nodes", b.channel_nodes, R),
+                    ("channel_flux", q, R),
+                    ("channel_aperture", ap, R),
+                    ("flow_saturation", sat, R),
+                    ("fluid_temperature", tf, R),
+                    ("fl_slots", b.slots, W),
+                ],
+            );
+            setup.kernel(Phase::Field, k)?;
+            let k = fconsts(Kernel::new(
+                "thermal fluid nodes",
+                kernel_source("fluid_node_kernel"),
+                net.n_nodes(),
+            ));
+            let k = bind(
+                k,
+                &[
+                    ("fl_inc_ptr", b.inc_ptr, R),
+                    ("fl_incidence", b.incidence, R),
+                    ("fl_slots", b.slots, R),
+                    ("fl_walls", b.walls, R),
+                    ("fl_fixed", b.fixed, R),
+                    ("temperature", temp, R),
+                    ("flow_saturation", sat, R),
+                    ("fluid_temperature", tf, W),
+                    ("fluid_heat_capacity", cap, W),
+                    ("fluid_heat_balance", bal, W),
+                    ("status", status, W),
+                ],
+            );
+            setup.kernel(Phase::Field, k)?;
+            Some((b, tf, fconsts))
+        }
+        _ => None,
+    };
     let k = consts(Kernel::new(
         "thermal nodes",
         kernel_source("node_kernel"),
@@ -175,6 +281,27 @@ pub(crate) fn program<D: Dim>(
         ],
     );
     setup.kernel(Phase::Field, k)?;
+    // The walls take the exchange at the fluid's new temperatures, after their rates.
+    if let Some((b, tf, fconsts)) = fluid_prog {
+        let k = fconsts(Kernel::new(
+            "thermal fluid walls",
+            kernel_source("fluid_wall_kernel"),
+            nn,
+        ));
+        let k = bind(
+            k,
+            &[
+                ("fl_wall_ptr", b.wall_ptr, R),
+                ("fl_wall_slots", b.wall_slots, R),
+                ("fl_slots", b.slots, R),
+                ("fl_channel_nodes", b.channel_nodes, R),
+                ("fluid_temperature", tf, R),
+                ("temperature", temp, R),
+                ("th_node_rate", node_rate, W),
+            ],
+        );
+        setup.kernel(Phase::Field, k)?;
+    }
     let k = consts(Kernel::new(
         "thermal groups",
         kernel_source("group_kernel"),
@@ -212,4 +339,16 @@ pub(crate) fn program<D: Dim>(
     );
     setup.kernel(Phase::Field, k)?;
     Ok(())
+}
+
+/// The device buffers of the fluid heat.
+struct FluidBuffers {
+    channel_nodes: GpuBuffer,
+    walls: GpuBuffer,
+    inc_ptr: GpuBuffer,
+    incidence: GpuBuffer,
+    wall_ptr: GpuBuffer,
+    wall_slots: GpuBuffer,
+    fixed: GpuBuffer,
+    slots: GpuBuffer,
 }

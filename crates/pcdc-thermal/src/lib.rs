@@ -12,6 +12,7 @@
 //! Faces     q_n A / N, h (T_env − T_l) A / N per face node           (boundary; 100–101)
 //! Node      T_l ← T_l + Δt (Σ R + face heat) / C_l, C_l = Σ ρ C_s Ω / N  (physics; 94, 99)
 //! Joints    split copies joined by conducting joints share one T      (physics; JointHeat)
+//! Fluid     channel conduction, upwind advection, wall exchange      (fluid; 102–110)
 //! ```
 //!
 //! ## Equations implemented (manual 7.6.1–7.6.2, 7.6.8; corrections marked)
@@ -46,13 +47,30 @@
 //! [`HEAT_CAPACITY`] and [`HEAT_SUPPLIED`] close it: Σ_l C_l (T_l − T_l⁰) = Σ_l
 //! supplied_l, to rounding (conduction only moves heat between nodes).
 //!
+//! ## Heat in the fracture fluid (eq. 102–110)
+//!
+//! With [`Thermal::fluid`] and the fluid physics (`pcdc_hydro::Hydro`) composed, every
+//! flow node carries a fluid temperature ([`FLUID_TEMPERATURE`]): conduction along the
+//! channels (102), upwind advection with the channels' fluxes (103–108, \[CORRECTED\]
+//! with the aperture), exchange h_sf A f(s)/N with each of the channel's two walls
+//! (109–110, \[CORRECTED\] share 1/N), fluid temperature conditions (table 15). Exchange
+//! and advection are point-implicit in the fluid node (a millimetre of water holds too
+//! little heat for an explicit step), which keeps the fluid temperatures within their
+//! inflow, wall and initial bounds at any step; the solid and fluid energy balance closes
+//! to rounding ([`output::energy_balance`]). The network is read through the shared keys
+//! of `pcdc_compute::names` (no dependency on `pcdc-hydro`); `Hydro::steady_flow` gives
+//! the settled flow that a slow heat problem runs on (the Lauwerier scene).
+//!
+//! ## GPU
+//!
+//! Kernels in `shaders/thermal.wgsl`, the CPU's arithmetic in the same order, parity to
+//! 1e-12 in f64 (fluid heat included). The thermal nodes are fixed for the run on the
+//! device: [`JointHeat::FollowDamage`] on a split mesh is refused there with
+//! `ComputeError::NoGpuKernel` (CPU only).
+//!
 //! ## Not yet built (issue 17)
 //!
-//! Conduction and advection in the fracture fluid (eq. 102–110) and contact conductance
-//! across broken joints (eq. 111–112) come next. On the GPU (kernels in
-//! `shaders/thermal.wgsl`, the CPU's arithmetic in the same order, parity to 1e-12 in
-//! f64) the thermal nodes are fixed for the run: [`JointHeat::FollowDamage`] on a split
-//! mesh is refused there with `ComputeError::NoGpuKernel` (CPU only).
+//! Contact conductance across broken joints (eq. 111–112): cracks insulate fully.
 
 #![warn(missing_docs)]
 #![allow(clippy::needless_range_loop)]

@@ -747,14 +747,6 @@ impl<D: Dim> Physics<D> for Thermal {
             .derived
             .as_ref()
             .ok_or_else(|| ComputeError::Gpu("thermal: GPU setup before init".into()))?;
-        if d.fluid.is_some() {
-            return Err(ComputeError::NoGpuKernel {
-                physics: "thermal".into(),
-                reason: "heat in the fracture fluid (Thermal::fluid) runs on the CPU only for \
-                         now"
-                .into(),
-            });
-        }
         if d.ids.and_then(|i| i.damage).is_some() {
             return Err(ComputeError::NoGpuKernel {
                 physics: "thermal".into(),
@@ -765,7 +757,11 @@ impl<D: Dim> Physics<D> for Thermal {
                     .into(),
             });
         }
-        crate::gpu::program(d, &self.faces, &self.fixed, setup)
+        let fluid = self
+            .fluid
+            .as_ref()
+            .map(|f| (f, self.fluid_fixed.as_slice()));
+        crate::gpu::program(d, &self.faces, &self.fixed, fluid, setup)
     }
 
     fn field_step(&mut self, ctx: &mut FieldContext<'_, D>) -> Result<(), ComputeError> {
@@ -901,10 +897,11 @@ impl<D: Dim> Physics<D> for Thermal {
                             let (conv, h, v) = values[entries.cond[j] as usize];
                             b += entries.share[j] * if conv { h * (v - temp[n]) } else { v };
                         }
-                        if let Some(fs) = fluid_state {
-                            s += fluid::wall_rate(&fs.net, &fs.slots, &fs.t_new, temp, n);
-                        }
                         *nr = s + b;
+                        // The walls' exchange last (the GPU adds it in a pass of its own).
+                        if let Some(fs) = fluid_state {
+                            *nr += fluid::wall_rate(&fs.net, &fs.slots, &fs.t_new, temp, n);
+                        }
                         *nb = b;
                     }
                 });

@@ -5,6 +5,12 @@
 //
 // Consts: D, NPE, FREE (no condition), ERR_DIVERGED. th_k holds k_ij of each material
 // (9 values, row-major 3 × 3); th_cond_kind 0 flux, 1 convection.
+//
+// Fluid heat (`fluid.rs`): `fluid_channel_kernel`, `fluid_node_kernel` (before the node
+// kernel: they read the solid's temperatures at the start of the step) and
+// `fluid_wall_kernel` (after it: the walls' exchange at the fluid's new temperatures).
+// Consts NPC (nodes per channel), RC = ρ_f C_f, KF = k_f, HSF = h_sf. fl_slots holds 5
+// values per channel node: volume share, exchange H, inflow, inflow heat, conducted.
 
 //!element_kernel
 // Per element: ∇T, q = −k ∇T (heat_flux) and the nodal rates R_a = Ω ∇N_a · q (eq. 95–98).
@@ -99,4 +105,182 @@ fn kernel(n: u32) {
         atomicMin(&status[2], ERR_DIVERGED);
         atomicMin(&status[3], n);
     }
+}
+
+//!fluid_channel_kernel
+// Per channel: midplane geometry, upwind inflow and conduction per channel node.
+fn sat_weight(s: Real) -> Real {
+    let x = clamp(s, Real(0.0), Real(1.0));
+    return x * x * (3.0 - 2.0 * x);
+}
+
+fn sub3(a: array<Real, 3>, b: array<Real, 3>) -> array<Real, 3> {
+    return array<Real, 3>(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
+
+fn dot3(a: array<Real, 3>, b: array<Real, 3>) -> Real {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+fn cross3(a: array<Real, 3>, b: array<Real, 3>) -> array<Real, 3> {
+    return array<Real, 3>(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]);
+}
+
+fn kernel(c: u32) {
+    var m: array<array<Real, 3>, 3>;
+    for (var k = 0u; k < NPC; k = k + 1u) {
+        let na = fl_walls[c * 2u * NPC + k] * D;
+        let nb = fl_walls[c * 2u * NPC + NPC + k] * D;
+        for (var q = 0u; q < D; q = q + 1u) {
+            let xa = coords[na + q] + disp[na + q];
+            let xb = coords[nb + q] + disp[nb + q];
+            m[k][q] = 0.5 * (xa + xb);
+        }
+    }
+    var qf = array<Real, 3>(0.0, 0.0, 0.0);
+    for (var d = 0u; d < D; d = d + 1u) {
+        qf[d] = channel_flux[c * D + d];
+    }
+    var measure = Real(0.0);
+    var weight = array<Real, 3>(0.0, 0.0, 0.0);
+    var rate = array<Real, 3>(0.0, 0.0, 0.0);
+    var ei = array<u32, 3>(0u, 1u, 2u);
+    var ej = array<u32, 3>(1u, 2u, 0u);
+    var ek = array<u32, 3>(0u, 0u, 1u);
+    var ne = 3u;
+    if NPC == 2u {
+        ne = 1u;
+        let t = sub3(m[1], m[0]);
+        let len = sqrt(dot3(t, t));
+        if len > 0.0 {
+            measure = len;
+            weight[0] = 1.0 / len;
+            rate[0] = dot3(qf, t) / len;
+        }
+    } else {
+        ek = array<u32, 3>(2u, 0u, 1u);
+        let nrm = cross3(sub3(m[1], m[0]), sub3(m[2], m[0]));
+        let twice = sqrt(dot3(nrm, nrm));
+        if twice > 0.0 {
+            measure = 0.5 * twice;
+            var cen: array<Real, 3>;
+            for (var d = 0u; d < 3u; d = d + 1u) {
+                cen[d] = (m[0][d] + m[1][d] + m[2][d]) / 3.0;
+            }
+            for (var e = 0u; e < 3u; e = e + 1u) {
+                let i = ei[e];
+                let j = ej[e];
+                let k = ek[e];
+                weight[e] = dot3(sub3(m[i], m[k]), sub3(m[j], m[k])) / (4.0 * measure);
+                var mid: array<Real, 3>;
+                for (var d = 0u; d < 3u; d = d + 1u) {
+                    mid[d] = 0.5 * (m[i][d] + m[j][d]);
+                }
+                let seg = sub3(cen, mid);
+                var n = cross3(seg, nrm);
+                n = array<Real, 3>(n[0] / twice, n[1] / twice, n[2] / twice);
+                if dot3(n, sub3(m[j], m[i])) < 0.0 {
+                    n = array<Real, 3>(-n[0], -n[1], -n[2]);
+                }
+                rate[e] = dot3(qf, n);
+            }
+        }
+    }
+    let ap = channel_aperture[c];
+    var vol: array<Real, 3>;
+    var exch: array<Real, 3>;
+    var inflow = array<Real, 3>(0.0, 0.0, 0.0);
+    var heat_in = array<Real, 3>(0.0, 0.0, 0.0);
+    var cond = array<Real, 3>(0.0, 0.0, 0.0);
+    var l: array<u32, 3>;
+    for (var k = 0u; k < NPC; k = k + 1u) {
+        l[k] = fl_channel_nodes[c * NPC + k];
+        vol[k] = ap * measure / Real(NPC);
+        exch[k] = HSF * measure * sat_weight(flow_saturation[l[k]]) / Real(NPC);
+    }
+    for (var e = 0u; e < ne; e = e + 1u) {
+        let i = ei[e];
+        let j = ej[e];
+        let a = l[i];
+        let b = l[j];
+        let f = rate[e] * RC;
+        if f > 0.0 {
+            inflow[j] = inflow[j] + f;
+            heat_in[j] = heat_in[j] + f * fluid_temperature[a];
+        } else if f < 0.0 {
+            inflow[i] = inflow[i] - f;
+            heat_in[i] = heat_in[i] - f * fluid_temperature[b];
+        }
+        let g = KF * ap * clamp(min(flow_saturation[a], flow_saturation[b]), Real(0.0), Real(1.0)) * weight[e];
+        let h = g * (fluid_temperature[b] - fluid_temperature[a]);
+        cond[i] = cond[i] + h;
+        cond[j] = cond[j] - h;
+    }
+    for (var k = 0u; k < NPC; k = k + 1u) {
+        let o = (c * NPC + k) * 5u;
+        fl_slots[o] = vol[k];
+        fl_slots[o + 1u] = exch[k];
+        fl_slots[o + 2u] = inflow[k];
+        fl_slots[o + 3u] = heat_in[k];
+        fl_slots[o + 4u] = cond[k];
+    }
+}
+
+//!fluid_node_kernel
+// Per flow node: the point-implicit update (or the held value) and the heat balance.
+fn kernel(l: u32) {
+    let dt = p_dt() * FIELD_DT_SCALE;
+    var vol = Real(0.0);
+    var a_in = Real(0.0);
+    var b_in = Real(0.0);
+    var h = Real(0.0);
+    var ht = Real(0.0);
+    var cond = Real(0.0);
+    for (var x = fl_inc_ptr[l]; x < fl_inc_ptr[l + 1u]; x = x + 1u) {
+        let e = fl_incidence[x];
+        let o = e * 5u;
+        let c = e / NPC;
+        let k = e % NPC;
+        vol = vol + fl_slots[o];
+        a_in = a_in + fl_slots[o + 2u];
+        b_in = b_in + fl_slots[o + 3u];
+        cond = cond + fl_slots[o + 4u];
+        h = h + 2.0 * fl_slots[o + 1u];
+        let wa = fl_walls[c * 2u * NPC + k];
+        let wb = fl_walls[c * 2u * NPC + NPC + k];
+        ht = ht + fl_slots[o + 1u] * (temperature[wa] + temperature[wb]);
+    }
+    let c_new = RC * clamp(flow_saturation[l], Real(0.0), Real(1.0)) * vol;
+    let t_old = fluid_temperature[l];
+    fluid_heat_balance[l * 4u + 3u] = fluid_heat_balance[l * 4u + 3u] + t_old * (c_new - fluid_heat_capacity[l]);
+    let den = c_new + dt * (a_in + h);
+    var unheld = t_old;
+    if den > 0.0 {
+        unheld = (c_new * t_old + dt * (b_in + ht + cond)) / den;
+    }
+    var next = unheld;
+    if fl_fixed[l] != FREE {
+        next = signal(fl_fixed[l]);
+    }
+    let adv = b_in - a_in * next;
+    let ex = ht - h * next;
+    fluid_heat_balance[l * 4u + 1u] = fluid_heat_balance[l * 4u + 1u] + (c_new * (next - t_old) - dt * (adv + ex + cond));
+    fluid_heat_balance[l * 4u + 2u] = fluid_heat_balance[l * 4u + 2u] + dt * adv;
+    fluid_temperature[l] = next;
+    fluid_heat_capacity[l] = c_new;
+    if !(abs(next) <= REAL_MAX) {
+        atomicMin(&status[2], ERR_DIVERGED);
+        atomicMin(&status[3], l);
+    }
+}
+
+//!fluid_wall_kernel
+// Per mesh node: the exchange with the fluid of the channels it walls, after its rate.
+fn kernel(n: u32) {
+    var w = Real(0.0);
+    for (var x = fl_wall_ptr[n]; x < fl_wall_ptr[n + 1u]; x = x + 1u) {
+        let e = fl_wall_slots[x];
+        w = w + fl_slots[e * 5u + 1u] * (fluid_temperature[fl_channel_nodes[e]] - temperature[n]);
+    }
+    th_node_rate[n] = th_node_rate[n] + w;
 }
