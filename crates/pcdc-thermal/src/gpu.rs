@@ -8,19 +8,21 @@
 //! the step) and a wall pass after it adds the exchange at the fluid's new temperatures.
 //!
 //! The thermal nodes (groups of split copies joined by conducting joints) are fixed on
-//! the device: [`crate::JointHeat::FollowDamage`] on a split mesh, whose groups split as
-//! joints break, is refused on the GPU (`ComputeError::NoGpuKernel`) until the device
-//! rebuilds them; unsplit meshes, `Conducting` and `Insulating` run.
+//! the device for unsplit meshes, `Conducting` and `Insulating`. With
+//! [`crate::JointHeat::FollowDamage`] on a split mesh, whose groups split as joints
+//! break, the group pass runs per original vertex instead: a union-find over the
+//! vertex's node pairs whose joints are intact (damage < 1) gives its thermal nodes,
+//! each updated with its members in ascending order as on the CPU.
 
 use pcdc_compute::gpu::{Access, GpuBuffer, GpuData, GpuSetup, Kernel, Phase};
-use pcdc_compute::names::TEMPERATURE;
+use pcdc_compute::names::{JOINT_DAMAGE, TEMPERATURE};
 use pcdc_compute::ComputeError;
 use pcdc_mesh::Dim;
 
 use crate::boundary::FaceHeat;
 use crate::fields::{FLUID_HEAT_BALANCE, FLUID_HEAT_CAPACITY, FLUID_TEMPERATURE};
 use crate::fields::{HEAT_CAPACITY, HEAT_FLUX, HEAT_SUPPLIED};
-use crate::physics::{Derived, FREE};
+use crate::physics::{Derived, Groups, FREE};
 use crate::FluidHeat;
 use pcdc_compute::names::{CHANNEL_APERTURE, CHANNEL_FLUX, FLOW_SATURATION};
 
@@ -48,6 +50,7 @@ pub(crate) fn program<D: Dim>(
     faces: &[(pcdc_mesh::Range, FaceHeat)],
     fixed: &[(pcdc_mesh::Range, pcdc_compute::TimeValue)],
     fluid: Option<(&FluidHeat, &[(pcdc_mesh::Range, pcdc_compute::TimeValue)])>,
+    follow_damage: bool,
     setup: &mut GpuSetup<'_, D>,
 ) -> Result<(), ComputeError> {
     let (dim, npe) = (D::D, D::NODES_PER_ELEM);
@@ -114,11 +117,33 @@ pub(crate) fn program<D: Dim>(
     let cond_sig = up_u(setup, "thermal condition signal", sig);
     let node_rate = up_r(setup, "thermal node rate", vec![0.0; nn]);
     let node_bnd = up_r(setup, "thermal node face heat", vec![0.0; nn]);
-    let group_start = up_u(setup, "thermal group start", d.groups.start.clone());
-    let members = up_u(setup, "thermal group members", d.groups.members.clone());
-    let group_of = up_u(setup, "thermal group of node", d.groups.of.clone());
+    // Joints that stop conducting when they break: per original vertex (the split copies
+    // the intact joints may join), its node pairs; the device finds the thermal nodes
+    // within each vertex every step, and writes per node ([`vertex_groups`]).
+    let vertex = if follow_damage {
+        Some(vertex_groups(setup.mesh)?)
+    } else {
+        None
+    };
+    let (gs, gm, go, gt_len) = match &vertex {
+        Some(v) => (
+            v.groups.start.clone(),
+            v.groups.members.clone(),
+            (0..nn as u32).collect(),
+            2 * nn,
+        ),
+        None => (
+            d.groups.start.clone(),
+            d.groups.members.clone(),
+            d.groups.of.clone(),
+            2 * ng,
+        ),
+    };
+    let group_start = up_u(setup, "thermal group start", gs);
+    let members = up_u(setup, "thermal group members", gm);
+    let group_of = up_u(setup, "thermal group of node", go);
     let fixed_buf = up_u(setup, "thermal held", held);
-    let group_temp = up_r(setup, "thermal group temperatures", vec![0.0; 2 * ng]);
+    let group_temp = up_r(setup, "thermal group temperatures", vec![0.0; gt_len]);
     let err = setup.error(|n| {
         format!("divergence: temperature not finite at node {n}. Hint: the thermal step is above the stable one (a fixed schedule too coarse?)")
     });
@@ -302,24 +327,56 @@ pub(crate) fn program<D: Dim>(
         );
         setup.kernel(Phase::Field, k)?;
     }
-    let k = consts(Kernel::new(
-        "thermal groups",
-        kernel_source("group_kernel"),
-        ng,
-    ));
-    let k = bind(
-        k,
-        &[
-            ("th_group_start", group_start, R),
-            ("th_members", members, R),
-            ("th_node_rate", node_rate, R),
-            ("heat_capacity", capacity, R),
-            ("th_fixed", fixed_buf, R),
-            ("temperature", temp, R),
-            ("th_group_temp", group_temp, W),
-        ],
-    );
-    setup.kernel(Phase::Field, k)?;
+    match vertex {
+        None => {
+            let k = consts(Kernel::new(
+                "thermal groups",
+                kernel_source("group_kernel"),
+                ng,
+            ));
+            let k = bind(
+                k,
+                &[
+                    ("th_group_start", group_start, R),
+                    ("th_members", members, R),
+                    ("th_node_rate", node_rate, R),
+                    ("heat_capacity", capacity, R),
+                    ("th_fixed", fixed_buf, R),
+                    ("temperature", temp, R),
+                    ("th_group_temp", group_temp, W),
+                ],
+            );
+            setup.kernel(Phase::Field, k)?;
+        }
+        Some(v) => {
+            let pair_start = up_u(setup, "thermal vertex pair start", v.pair_start);
+            let pairs = up_u(setup, "thermal vertex pairs", v.pairs);
+            let damage = setup.field(JOINT_DAMAGE)?;
+            let nv = v.groups.len();
+            let k = consts(Kernel::new(
+                "thermal vertex groups",
+                kernel_source("vertex_group_kernel"),
+                nv,
+            ))
+            .const_u32("MAXV", MAX_COPIES as u32);
+            let k = bind(
+                k,
+                &[
+                    ("th_group_start", group_start, R),
+                    ("th_members", members, R),
+                    ("th_pair_start", pair_start, R),
+                    ("th_pairs", pairs, R),
+                    ("joint_damage", damage, R),
+                    ("th_node_rate", node_rate, R),
+                    ("heat_capacity", capacity, R),
+                    ("th_fixed", fixed_buf, R),
+                    ("temperature", temp, R),
+                    ("th_group_temp", group_temp, W),
+                ],
+            );
+            setup.kernel(Phase::Field, k)?;
+        }
+    }
     let k = consts(Kernel::new(
         "thermal write",
         kernel_source("write_kernel"),
@@ -351,4 +408,63 @@ struct FluidBuffers {
     wall_slots: GpuBuffer,
     fixed: GpuBuffer,
     slots: GpuBuffer,
+}
+
+/// The most split copies of one vertex the device's thermal-node search holds.
+pub(crate) const MAX_COPIES: usize = 64;
+
+/// The split copies of every original vertex (the thermal nodes when every joint
+/// conducts) and, per vertex, the node pairs of the joints between them: 3 values per
+/// pair, the joint and the local indices (in the vertex's ascending members) of its two
+/// nodes.
+struct VertexGroups {
+    groups: Groups,
+    pair_start: Vec<u32>,
+    pairs: Vec<u32>,
+}
+
+fn vertex_groups<D: Dim>(mesh: &pcdc_mesh::Mesh<D>) -> Result<VertexGroups, ComputeError> {
+    let groups = Groups::build(mesh, |_| true);
+    let nv = groups.len();
+    if let Some(v) =
+        (0..nv).find(|&v| (groups.start[v + 1] - groups.start[v]) as usize > MAX_COPIES)
+    {
+        return Err(ComputeError::NoGpuKernel {
+            physics: "thermal".into(),
+            reason: format!(
+                "a vertex with {} split copies (node {}); joints that stop conducting when \
+                 they break are followed on the device for at most {MAX_COPIES} copies per \
+                 vertex: use the CPU",
+                groups.start[v + 1] - groups.start[v],
+                groups.members[groups.start[v] as usize]
+            ),
+        });
+    }
+    let local = |n: u32| -> u32 {
+        let v = groups.of[n as usize] as usize;
+        let m = &groups.members[groups.start[v] as usize..groups.start[v + 1] as usize];
+        m.binary_search(&n).map_or(u32::MAX, |i| i as u32)
+    };
+    let joints = mesh.interfaces();
+    let mut by_vertex: Vec<Vec<[u32; 3]>> = vec![Vec::new(); nv];
+    for j in 0..joints.len() {
+        let Some(iface) = joints.get(j) else { continue };
+        for (a, b) in iface.node_pairs() {
+            by_vertex[groups.of[a as usize] as usize].push([j as u32, local(a), local(b)]);
+        }
+    }
+    let mut pair_start = Vec::with_capacity(nv + 1);
+    pair_start.push(0u32);
+    let mut pairs = Vec::new();
+    for list in by_vertex {
+        for p in list {
+            pairs.extend_from_slice(&p);
+        }
+        pair_start.push((pairs.len() / 3) as u32);
+    }
+    Ok(VertexGroups {
+        groups,
+        pair_start,
+        pairs,
+    })
 }

@@ -64,9 +64,9 @@
 //! ## GPU
 //!
 //! Kernels in `shaders/thermal.wgsl`, the CPU's arithmetic in the same order, parity to
-//! 1e-12 in f64 (fluid heat included). The thermal nodes are fixed for the run on the
-//! device: [`JointHeat::FollowDamage`] on a split mesh is refused there with
-//! `ComputeError::NoGpuKernel` (CPU only).
+//! 1e-12 in f64 (fluid heat included). With [`JointHeat::FollowDamage`] on a split mesh
+//! the device finds the thermal nodes per original vertex every step from the damage
+//! (at most 64 split copies per vertex; more is refused with `ComputeError::NoGpuKernel`).
 //!
 //! ## Not yet built (issue 17)
 //!

@@ -176,7 +176,7 @@ pub(crate) struct Groups {
 
 impl Groups {
     /// The groups of `n` nodes joined by the node pairs of the conducting joints.
-    fn build<D: Dim>(mesh: &Mesh<D>, conducts: impl Fn(usize) -> bool) -> Self {
+    pub(crate) fn build<D: Dim>(mesh: &Mesh<D>, conducts: impl Fn(usize) -> bool) -> Self {
         let n = mesh.n_nodes();
         let mut parent: Vec<u32> = (0..n as u32).collect();
         fn find(p: &mut [u32], mut x: u32) -> u32 {
@@ -328,7 +328,7 @@ impl Thermal {
     /// Heat in the fracture fluid of the flow network (eq. 102–110; see the `fluid`
     /// section of the crate docs): conduction along the channels, upwind advection with
     /// their fluxes, exchange with the channel walls. Needs the fluid physics
-    /// (`pcdc_hydro::Hydro`) composed in the same simulation; CPU only for now.
+    /// (`pcdc_hydro::Hydro`) composed in the same simulation. CPU and GPU.
     pub fn fluid(mut self, fluid: FluidHeat) -> Self {
         self.fluid = Some(fluid);
         self
@@ -747,21 +747,18 @@ impl<D: Dim> Physics<D> for Thermal {
             .derived
             .as_ref()
             .ok_or_else(|| ComputeError::Gpu("thermal: GPU setup before init".into()))?;
-        if d.ids.and_then(|i| i.damage).is_some() {
-            return Err(ComputeError::NoGpuKernel {
-                physics: "thermal".into(),
-                reason: "joints that stop conducting when they break (JointHeat::FollowDamage \
-                         on a split mesh) need thermal nodes rebuilt during the run, which the \
-                         GPU program does not do yet: use the CPU, or JointHeat::Conducting / \
-                         Insulating"
-                    .into(),
-            });
-        }
         let fluid = self
             .fluid
             .as_ref()
             .map(|f| (f, self.fluid_fixed.as_slice()));
-        crate::gpu::program(d, &self.faces, &self.fixed, fluid, setup)
+        crate::gpu::program(
+            d,
+            &self.faces,
+            &self.fixed,
+            fluid,
+            self.reads_damage(setup.mesh),
+            setup,
+        )
     }
 
     fn field_step(&mut self, ctx: &mut FieldContext<'_, D>) -> Result<(), ComputeError> {

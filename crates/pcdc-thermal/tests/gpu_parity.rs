@@ -143,30 +143,84 @@ fn kernels_validate_with_naga() {
                 panic!("{label} ({}) does not validate:\n{e}", p.name());
             }
         }
+        // Joints that follow the damage: the per-vertex kernel.
+        let s2 = pcdc_mesh::split_nodes(&m2, &Range::All).unwrap();
+        let s3 = pcdc_mesh::split_nodes(&m3, &Range::All).unwrap();
+        let k2 = offline_kernel_sources::<_>(
+            &s2,
+            vec![
+                Box::new(heat(&s2).joints(JointHeat::FollowDamage).heat_only()),
+                Box::new(DamageOwner { crack_x: None }),
+            ],
+            p,
+        )
+        .unwrap();
+        let k3 = offline_kernel_sources::<_>(
+            &s3,
+            vec![
+                Box::new(heat(&s3).joints(JointHeat::FollowDamage).heat_only()),
+                Box::new(DamageOwner { crack_x: None }),
+            ],
+            p,
+        )
+        .unwrap();
+        let vertex: Vec<_> = k2
+            .iter()
+            .chain(&k3)
+            .filter(|(l, _)| l == "thermal vertex groups")
+            .collect();
+        assert_eq!(vertex.len(), 2, "the vertex kernel in 2D and 3D");
+        for (label, src) in vertex {
+            if let Err(e) = validate_wgsl(src) {
+                panic!("{label} ({}) does not validate:\n{e}", p.name());
+            }
+        }
     }
 }
 
-/// A split mesh whose joints follow the damage needs groups the device cannot rebuild
-/// yet: refused by name, never run wrong.
+/// Joints that follow the damage on a split mesh: the device finds the thermal nodes
+/// within each vertex from the damage every step. A vertical crack (its joints broken
+/// from the start) stops the heat: the CPU and GPU agree to 1e-12 and nothing crosses.
 #[test]
-fn damage_following_joints_are_refused_on_the_gpu() {
+fn damage_following_joints_match_the_cpu_and_insulate() {
+    let mesh = builders::rectangle(0.0, 0.0, 0.2, 0.1, 0.0125).unwrap();
+    let split = pcdc_mesh::split_nodes(&mesh, &Range::All).unwrap();
+    let run = |backend: Backend| {
+        let thermal = Thermal::new()
+            .material(Range::All, HeatMaterial::new(3.0, 800.0, 2700.0).unwrap())
+            .initial_temperature(20.0)
+            .temperature(Range::group("left"), 100.0)
+            .joints(JointHeat::FollowDamage)
+            .heat_only();
+        let mut sim = Simulation::builder(split.clone(), backend)
+            .physics(thermal)
+            .physics(DamageOwner { crack_x: Some(0.1) })
+            .build()
+            .unwrap();
+        sim.run(400).unwrap();
+        fields(&sim)
+    };
+    let cpu = run(Backend::cpu(1).unwrap());
+    let t = &cpu[0];
+    let mut crossed = 0.0f64;
+    for n in 0..split.n_nodes() {
+        if split.node(n)[0] > 0.1 + 1e-9 {
+            crossed = crossed.max((t[n] - 20.0).abs());
+        }
+    }
+    assert_eq!(crossed, 0.0, "heat crossed the crack");
+    assert!(t.iter().any(|&x| x > 30.0), "heat entered the left part");
     let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
         return;
     };
-    let mesh = builders::rectangle(0.0, 0.0, 0.2, 0.1, 0.05).unwrap();
-    let split = pcdc_mesh::split_nodes(&mesh, &Range::All).unwrap();
-    let thermal = heat(&mesh).joints(JointHeat::FollowDamage).heat_only();
-    let err = Simulation::builder(split, gpu)
-        .physics(thermal)
-        .physics(DamageOwner)
-        .build()
-        .err()
-        .expect("refused");
-    assert!(err.to_string().contains("thermal"), "{err}");
+    check(&cpu, &run(gpu), "2D cracked, FollowDamage");
 }
 
-/// Owns `names::JOINT_DAMAGE` (all zero), standing in for the cohesive joints.
-struct DamageOwner;
+/// Owns `names::JOINT_DAMAGE`, standing in for the cohesive joints: all intact, or
+/// broken (1) on the joints of the vertical line x = `crack_x`.
+struct DamageOwner {
+    crack_x: Option<f64>,
+}
 
 impl<D: Dim> Physics<D> for DamageOwner {
     fn name(&self) -> &str {
@@ -175,7 +229,23 @@ impl<D: Dim> Physics<D> for DamageOwner {
     fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
         vec![names::JOINT_DAMAGE.own::<D>()]
     }
-    fn init(&mut self, _ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
+    fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
+        let Some(x) = self.crack_x else {
+            return Ok(());
+        };
+        let joints = ctx.mesh.interfaces();
+        let broken: Vec<bool> = (0..joints.len())
+            .map(|j| {
+                joints
+                    .joint_nodes(j)
+                    .iter()
+                    .all(|&n| (ctx.mesh.node(n as usize)[0] - x).abs() < 1e-9)
+            })
+            .collect();
+        let id = ctx.fields.id(names::JOINT_DAMAGE)?;
+        for (d, b) in ctx.fields.get_mut(id).iter_mut().zip(broken) {
+            *d = if b { 1.0 } else { 0.0 };
+        }
         Ok(())
     }
     fn compute_forces(&mut self, _ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {

@@ -92,6 +92,72 @@ fn kernel(g: u32) {
     th_group_temp[2u * g + 1u] = next;
 }
 
+//!vertex_group_kernel
+// Per original vertex, with joints that stop conducting when they break: its split
+// copies joined by intact joints (damage < 1) form the thermal nodes (smallest local
+// index names each), each updated as in group_kernel, members in ascending order; the
+// result goes to every member node (th_group_of is the identity here).
+fn kernel(v: u32) {
+    let dt = p_dt() * FIELD_DT_SCALE;
+    let first = th_group_start[v];
+    let count = th_group_start[v + 1u] - first;
+    var parent: array<u32, MAXV>;
+    for (var i = 0u; i < count; i = i + 1u) {
+        parent[i] = i;
+    }
+    for (var p = th_pair_start[v]; p < th_pair_start[v + 1u]; p = p + 1u) {
+        if joint_damage[th_pairs[3u * p]] >= 1.0 {
+            continue;
+        }
+        var a = th_pairs[3u * p + 1u];
+        while parent[a] != a {
+            a = parent[a];
+        }
+        var b = th_pairs[3u * p + 2u];
+        while parent[b] != b {
+            b = parent[b];
+        }
+        parent[max(a, b)] = min(a, b);
+    }
+    for (var i = 0u; i < count; i = i + 1u) {
+        var r = i;
+        while parent[r] != r {
+            r = parent[r];
+        }
+        parent[i] = r;
+    }
+    for (var root = 0u; root < count; root = root + 1u) {
+        if parent[root] != root {
+            continue;
+        }
+        var rate = Real(0.0);
+        var c = Real(0.0);
+        var held = FREE;
+        for (var i = root; i < count; i = i + 1u) {
+            if parent[i] == root {
+                let n = th_members[first + i];
+                rate = rate + th_node_rate[n];
+                c = c + heat_capacity[n];
+                if th_fixed[n] != FREE {
+                    held = th_fixed[n];
+                }
+            }
+        }
+        let unheld = temperature[th_members[first + root]] + dt * rate / c;
+        var next = unheld;
+        if held != FREE {
+            next = signal(held);
+        }
+        for (var i = root; i < count; i = i + 1u) {
+            if parent[i] == root {
+                let n = th_members[first + i];
+                th_group_temp[2u * n] = unheld;
+                th_group_temp[2u * n + 1u] = next;
+            }
+        }
+    }
+}
+
 //!write_kernel
 // Per node: the group's temperature and the heat supplied from outside.
 fn kernel(n: u32) {
