@@ -15,7 +15,7 @@
 //! each updated with its members in ascending order as on the CPU.
 
 use pcdc_compute::gpu::{Access, GpuBuffer, GpuData, GpuSetup, Kernel, Phase};
-use pcdc_compute::names::{JOINT_DAMAGE, TEMPERATURE};
+use pcdc_compute::names::{JOINT_DAMAGE, JOINT_OPENING, JOINT_SLIDING, TEMPERATURE};
 use pcdc_compute::ComputeError;
 use pcdc_mesh::Dim;
 
@@ -321,6 +321,39 @@ pub(crate) fn program<D: Dim>(
                 ("fl_slots", b.slots, R),
                 ("fl_channel_nodes", b.channel_nodes, R),
                 ("fluid_temperature", tf, R),
+                ("temperature", temp, R),
+                ("th_node_rate", node_rate, W),
+            ],
+        );
+        setup.kernel(Phase::Field, k)?;
+    }
+    // Then broken joints whose faces touch (contact module).
+    if let Some(p) = &d.contact {
+        let ptr = up_u(setup, "thermal contact ptr", p.ptr.clone());
+        let entries = up_u(setup, "thermal contact entries", p.entries.clone());
+        let share = up_r(setup, "thermal contact share", p.share.clone());
+        let size = up_r(setup, "thermal contact size", p.size.clone());
+        let (damage, opening, sliding) = (
+            setup.field(JOINT_DAMAGE)?,
+            setup.field(JOINT_OPENING)?,
+            setup.field(JOINT_SLIDING)?,
+        );
+        let k = consts(Kernel::new(
+            "thermal contact",
+            kernel_source("contact_kernel"),
+            nn,
+        ))
+        .const_real("HC", p.h);
+        let k = bind(
+            k,
+            &[
+                ("th_ct_ptr", ptr, R),
+                ("th_ct_entries", entries, R),
+                ("th_ct_share", share, R),
+                ("th_ct_size", size, R),
+                ("joint_damage", damage, R),
+                ("joint_opening", opening, R),
+                ("joint_sliding", sliding, R),
                 ("temperature", temp, R),
                 ("th_node_rate", node_rate, W),
             ],

@@ -68,15 +68,20 @@
 //! the device finds the thermal nodes per original vertex every step from the damage
 //! (at most 64 split copies per vertex; more is refused with `ComputeError::NoGpuKernel`).
 //!
-//! ## Not yet built (issue 17)
+//! ## Contact across broken joints (eq. 111–112)
 //!
-//! Contact conductance across broken joints (eq. 111–112): cracks insulate fully.
+//! With [`Thermal::contact_conductance`] a broken joint whose faces still touch
+//! (opening in [−L/2, 0], sliding below L/2, from the cohesive joints) carries
+//! (1/N) h_c A (T_m − T_l) between its node pairs \[NOT IN MANUAL: node pairs of the
+//! joint for the manual's element temperatures\]; an open crack insulates. Contacts
+//! between faces that were never joined carry no heat yet.
 
 #![warn(missing_docs)]
 #![allow(clippy::needless_range_loop)]
 
 mod boundary;
 mod conduction;
+mod contact;
 pub mod fields;
 mod fluid;
 mod gpu;

@@ -3,7 +3,7 @@
 use std::sync::Arc;
 
 use pcdc_compute::gpu::GpuSetup;
-use pcdc_compute::names::{JOINT_DAMAGE, TEMPERATURE};
+use pcdc_compute::names::{JOINT_DAMAGE, JOINT_OPENING, JOINT_SLIDING, TEMPERATURE};
 use pcdc_compute::{
     ComputeError, Entity, EntityKind, FieldContext, FieldId, FieldSchedule, FieldStore, FieldUse,
     ForceContext, InitContext, KinematicNodes, Kinematics, Physics, StableStep, TimeValue,
@@ -13,6 +13,7 @@ use rayon::prelude::*;
 
 use crate::boundary::{self, FaceHeat, NodeEntries};
 use crate::conduction::{self, Geometry};
+use crate::contact;
 use crate::fields::{
     FLUID_HEAT_BALANCE, FLUID_HEAT_CAPACITY, FLUID_TEMPERATURE, HEAT_CAPACITY, HEAT_FLUX,
     HEAT_SUPPLIED,
@@ -35,9 +36,9 @@ pub(crate) const FREE: u32 = u32::MAX;
 /// it conducts as the rock does: the split copies of a vertex joined by intact joints
 /// form one thermal node (their rates and capacities are summed, they share one
 /// temperature), exactly the conduction of the unsplit mesh, with no interface
-/// conductance to choose and no smaller stable step. A broken joint insulates (contact
-/// conductance across open cracks is not modelled yet), so cracks act as the thermal
-/// barriers they are.
+/// conductance to choose and no smaller stable step. A broken joint insulates, so cracks
+/// act as the thermal barriers they are, unless its faces still touch and a contact
+/// conductance is given ([`Thermal::contact_conductance`], eq. 111–112).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum JointHeat {
     /// Intact joints conduct, broken ones (damage 1, `names::JOINT_DAMAGE`, owned by
@@ -95,6 +96,7 @@ pub struct Thermal {
     fluid: Option<FluidHeat>,
     fluid_fixed: Vec<(Range, TimeValue)>,
     fluid_initial: Option<f64>,
+    contact: Option<f64>,
     derived: Option<Derived>,
 }
 
@@ -128,6 +130,8 @@ pub(crate) struct Derived {
     rows: Vec<f64>,
     pub(crate) ids: Option<Ids>,
     pub(crate) fluid: Option<FluidState>,
+    /// Joint node pairs for the contact conductance (eq. 111–112).
+    pub(crate) contact: Option<contact::Pairs>,
     // Work arrays.
     pub(crate) rates: Vec<f64>,
     pub(crate) node_rate: Vec<f64>,
@@ -163,6 +167,8 @@ pub(crate) struct Ids {
     supplied: FieldId,
     capacity: FieldId,
     damage: Option<FieldId>,
+    /// Opening and sliding of the joints, with a contact conductance.
+    touch: Option<(FieldId, FieldId)>,
 }
 
 /// Thermal nodes: the mesh nodes joined through conducting joints (CSR, members
@@ -247,6 +253,7 @@ impl Thermal {
             fluid: None,
             fluid_fixed: Vec::new(),
             fluid_initial: None,
+            contact: None,
             derived: None,
         }
     }
@@ -331,6 +338,16 @@ impl Thermal {
     /// (`pcdc_hydro::Hydro`) composed in the same simulation. CPU and GPU.
     pub fn fluid(mut self, fluid: FluidHeat) -> Self {
         self.fluid = Some(fluid);
+        self
+    }
+
+    /// Heat across broken joints whose faces still touch, through a contact conductance
+    /// h_c (W/(m²·K), ≥ 0; eq. 111–112, see the crate docs): with
+    /// [`JointHeat::FollowDamage`] on a split mesh whose cohesive joints publish their
+    /// damage, opening and sliding (`pcdc_cohesive`). Without it a broken joint
+    /// insulates.
+    pub fn contact_conductance(mut self, h_c: f64) -> Self {
+        self.contact = Some(h_c);
         self
     }
 
@@ -572,6 +589,24 @@ impl Thermal {
                 }
             }
         }
+        let contact = match self.contact {
+            None => None,
+            Some(h) => {
+                if mesh.interfaces().is_empty() || self.joints != JointHeat::FollowDamage {
+                    return Err(ComputeError::param(
+                        "contact conductance",
+                        h,
+                        "acts across broken joints: it needs a split mesh and \
+                         JointHeat::FollowDamage (the default)",
+                    ));
+                }
+                let p = contact::pairs(mesh, h)?;
+                for (r, c) in rows.iter_mut().zip(contact::rows(&p, nn)) {
+                    *r += c;
+                }
+                Some(p)
+            }
+        };
         let stable = solid_stable(&capacity, &rows);
         Ok(Derived {
             rates: vec![0.0; ne * npe],
@@ -592,6 +627,7 @@ impl Thermal {
             rows,
             ids: None,
             fluid: None,
+            contact,
         })
     }
 }
@@ -623,6 +659,10 @@ impl<D: Dim> Physics<D> for Thermal {
         ];
         if self.reads_damage(mesh) {
             f.push(JOINT_DAMAGE.read_lagged::<D>());
+            if self.contact.is_some() {
+                f.push(JOINT_OPENING.read_lagged::<D>());
+                f.push(JOINT_SLIDING.read_lagged::<D>());
+            }
         }
         if self.fluid.is_some() {
             f.extend([
@@ -656,6 +696,11 @@ impl<D: Dim> Physics<D> for Thermal {
             capacity: fields.id(HEAT_CAPACITY)?,
             damage: if self.reads_damage(ctx.mesh) {
                 Some(fields.id(JOINT_DAMAGE)?)
+            } else {
+                None
+            },
+            touch: if self.contact.is_some() && self.reads_damage(ctx.mesh) {
+                Some((fields.id(JOINT_OPENING)?, fields.id(JOINT_SLIDING)?))
             } else {
                 None
             },
@@ -816,6 +861,16 @@ impl<D: Dim> Physics<D> for Thermal {
             });
             fs.t_new.copy_from_slice(tf);
         }
+        // Contact across broken joints reads the joints' state at the start of the step.
+        let touch = match (ids.touch, ids.damage) {
+            (Some((o, s)), Some(dm)) => Some((
+                ctx.fields.get(dm).to_vec(),
+                ctx.fields.get(o).to_vec(),
+                ctx.fields.get(s).to_vec(),
+            )),
+            _ => None,
+        };
+        let contact_state = d.contact.as_ref().zip(touch.as_ref());
         let fluid_state = d.fluid.as_ref();
         let conn = ctx.kin.mesh.elements();
         let [temp, flux, supplied] = ctx.fields.get_many_mut([ids.temp, ids.flux, ids.supplied]);
@@ -898,6 +953,10 @@ impl<D: Dim> Physics<D> for Thermal {
                         // The walls' exchange last (the GPU adds it in a pass of its own).
                         if let Some(fs) = fluid_state {
                             *nr += fluid::wall_rate(&fs.net, &fs.slots, &fs.t_new, temp, n);
+                        }
+                        // Then broken joints whose faces touch (eq. 111–112).
+                        if let Some((p, (dmg, op, sl))) = contact_state {
+                            *nr += contact::rate(p, n, dim, temp, dmg, op, sl);
                         }
                         *nb = b;
                     }

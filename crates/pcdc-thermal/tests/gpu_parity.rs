@@ -164,12 +164,52 @@ fn kernels_validate_with_naga() {
             p,
         )
         .unwrap();
+        let c2 = offline_kernel_sources::<_>(
+            &s2,
+            vec![
+                Box::new(
+                    heat(&s2)
+                        .joints(JointHeat::FollowDamage)
+                        .contact_conductance(100.0)
+                        .heat_only(),
+                ),
+                Box::new(CrackOwner {
+                    crack_x: 0.1,
+                    opening: 0.0,
+                }),
+            ],
+            p,
+        )
+        .unwrap();
+        let c3 = offline_kernel_sources::<_>(
+            &s3,
+            vec![
+                Box::new(
+                    heat(&s3)
+                        .joints(JointHeat::FollowDamage)
+                        .contact_conductance(100.0)
+                        .heat_only(),
+                ),
+                Box::new(CrackOwner {
+                    crack_x: 0.05,
+                    opening: 0.0,
+                }),
+            ],
+            p,
+        )
+        .unwrap();
         let vertex: Vec<_> = k2
             .iter()
             .chain(&k3)
-            .filter(|(l, _)| l == "thermal vertex groups")
+            .chain(&c2)
+            .chain(&c3)
+            .filter(|(l, _)| l == "thermal vertex groups" || l == "thermal contact")
             .collect();
-        assert_eq!(vertex.len(), 2, "the vertex kernel in 2D and 3D");
+        assert_eq!(
+            vertex.len(),
+            6,
+            "the vertex kernel in 2D and 3D, twice, and contact"
+        );
         for (label, src) in vertex {
             if let Err(e) = validate_wgsl(src) {
                 panic!("{label} ({}) does not validate:\n{e}", p.name());
@@ -220,6 +260,120 @@ fn damage_following_joints_match_the_cpu_and_insulate() {
 /// broken (1) on the joints of the vertical line x = `crack_x`.
 struct DamageOwner {
     crack_x: Option<f64>,
+}
+
+/// Like [`DamageOwner`], and owns the joints' opening (`opening` on every joint) and
+/// sliding (0), as the cohesive joints publish them.
+struct CrackOwner {
+    crack_x: f64,
+    opening: f64,
+}
+
+impl<D: Dim> Physics<D> for CrackOwner {
+    fn name(&self) -> &str {
+        "crack owner"
+    }
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
+        vec![
+            names::JOINT_DAMAGE.own::<D>(),
+            names::JOINT_OPENING.own::<D>().initial(self.opening),
+            names::JOINT_SLIDING.own::<D>(),
+        ]
+    }
+    fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
+        DamageOwner {
+            crack_x: Some(self.crack_x),
+        }
+        .init(ctx)
+    }
+    fn compute_forces(&mut self, _ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+        Ok(())
+    }
+    fn gpu_setup(&mut self, _setup: &mut GpuSetup<'_, D>) -> Result<(), ComputeError> {
+        Ok(())
+    }
+}
+
+/// Contact conductance across a closed crack (eq. 111–112): at steady state the bar
+/// carries q = ΔT / (L₁/k + 1/h_c + L₂/k) and the crack's faces differ by q/h_c; an
+/// open crack carries nothing. The GPU matches the CPU to 1e-12.
+#[test]
+fn closed_crack_conducts_through_the_contact_conductance() {
+    let mesh = builders::rectangle(0.0, 0.0, 0.2, 0.1, 0.0125).unwrap();
+    let split = pcdc_mesh::split_nodes(&mesh, &Range::All).unwrap();
+    let (k, h_c) = (3.0, 300.0);
+    let run = |backend: Backend, opening: f64, steps: u64| {
+        let thermal = Thermal::new()
+            .material(Range::All, HeatMaterial::new(k, 800.0, 2700.0).unwrap())
+            .initial_temperature(0.0)
+            .temperature(Range::group("left"), 100.0)
+            .temperature(Range::group("right"), 0.0)
+            .contact_conductance(h_c)
+            .heat_only();
+        let mut sim = Simulation::builder(split.clone(), backend)
+            .physics(thermal)
+            .physics(CrackOwner {
+                crack_x: 0.1,
+                opening,
+            })
+            .build()
+            .unwrap();
+        sim.run(steps).unwrap();
+        fields(&sim)
+    };
+    let closed = run(Backend::cpu(1).unwrap(), -1e-6, 20_000);
+    let q = 100.0 / (0.1 / k + 1.0 / h_c + 0.1 / k);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (n, &t) in closed[0].iter().enumerate() {
+        if (split.node(n)[0] - 0.1).abs() < 1e-9 {
+            lo = lo.min(t);
+            hi = hi.max(t);
+        }
+    }
+    // Both faces at the crack: T(0.1⁻) = 100 − q L₁/k, T(0.1⁺) = q L₂/k.
+    let (left, right) = (100.0 - q * 0.1 / k, q * 0.1 / k);
+    assert!((hi - left).abs() < 1e-6 * 100.0, "left face {hi} vs {left}");
+    assert!(
+        (lo - right).abs() < 1e-6 * 100.0,
+        "right face {lo} vs {right}"
+    );
+    let open = run(Backend::cpu(1).unwrap(), 1e-6, 2_000);
+    for (n, &t) in open[0].iter().enumerate() {
+        let x = split.node(n)[0];
+        if x > 0.1 + 1e-9 {
+            assert_eq!(t, 0.0, "heat crossed an open crack at x = {x}");
+        }
+    }
+    // Bad input: a negative conductance, or one where no joint can break.
+    let refuse = |t: Thermal| {
+        Simulation::builder(split.clone(), Backend::cpu(1).unwrap())
+            .physics(t.heat_only())
+            .physics(CrackOwner {
+                crack_x: 0.1,
+                opening: 0.0,
+            })
+            .build()
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    let base = || Thermal::new().material(Range::All, HeatMaterial::new(k, 800.0, 2700.0).unwrap());
+    let e = refuse(base().contact_conductance(-1.0));
+    assert!(e.contains("h_c"), "{e}");
+    let e = refuse(
+        base()
+            .joints(JointHeat::Conducting)
+            .contact_conductance(10.0),
+    );
+    assert!(e.contains("FollowDamage"), "{e}");
+    let Some(gpu) = gpu_test_backend(Some(Precision::F64)) else {
+        return;
+    };
+    check(
+        &run(Backend::cpu(1).unwrap(), -1e-6, 300),
+        &run(gpu, -1e-6, 300),
+        "2D closed crack, contact conductance",
+    );
 }
 
 impl<D: Dim> Physics<D> for DamageOwner {

@@ -67,6 +67,29 @@ fn kernel(n: u32) {
     th_node_bnd[n] = b;
 }
 
+//!contact_kernel
+// Per node, after its rate: heat across its pairs on broken joints whose faces touch
+// (contact.rs; eq. 111–112), opening in [−L/2, 0] and sliding below L/2.
+fn kernel(n: u32) {
+    var r = Real(0.0);
+    for (var e = th_ct_ptr[n]; e < th_ct_ptr[n + 1u]; e = e + 1u) {
+        let j = th_ct_entries[2u * e];
+        let m = th_ct_entries[2u * e + 1u];
+        let size = th_ct_size[j];
+        let o = joint_opening[j];
+        var s2 = Real(0.0);
+        for (var q = 0u; q < D; q = q + 1u) {
+            let x = joint_sliding[j * D + q];
+            s2 = s2 + x * x;
+        }
+        let touching = o <= 0.0 && o >= -0.5 * size && s2 <= 0.25 * size * size;
+        if joint_damage[j] >= 1.0 && touching {
+            r = r + HC * th_ct_share[e] * (temperature[m] - temperature[n]);
+        }
+    }
+    th_node_rate[n] = th_node_rate[n] + r;
+}
+
 //!group_kernel
 // Per thermal node: one explicit update (eq. 94, 99 corrected), or the held value.
 fn kernel(g: u32) {
