@@ -84,7 +84,7 @@ pub(crate) fn pairs<D: Dim>(mesh: &Mesh<D>, h: f64) -> Result<Pairs, ComputeErro
             list.push((nb, j as u32, na, share));
         }
     }
-    list.sort_by(|x, y| (x.0, x.1, x.2).cmp(&(y.0, y.1, y.2)));
+    list.sort_by_key(|x| (x.0, x.1, x.2));
     let mut ptr = vec![0u32; nn + 1];
     for e in &list {
         ptr[e.0 as usize + 1] += 1;
