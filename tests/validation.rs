@@ -4,7 +4,8 @@
 use pcdc::compute::Backend;
 use pcdc_validation::scenes::{
     fracture_flow, half_space_conduction, injection, kirsch, lauwerier, radial_flow,
-    slope_excavation, thermal_cylinder, unconfined_flow, vibration_energy, wave_speed, Element,
+    slope_excavation, thermal_cracking, thermal_cylinder, unconfined_flow, vibration_energy,
+    wave_speed, Element,
 };
 
 fn cpu() -> Backend {
@@ -477,4 +478,28 @@ fn lauwerier_within_5_percent() {
     );
     assert!((o.velocity - lauwerier::VELOCITY).abs() < 1e-9 * lauwerier::VELOCITY);
     assert!(o.error <= lauwerier::TOL, "error {}", o.error);
+}
+
+/// Thermal cracking (manual 7.6.10) at its coarsest size: the first joint softens where
+/// the closed-form hoop stress of the computed temperature field peaks (the outer
+/// surface), radial, when the closed-form traction on it is within 10 % of T_s; the
+/// cracks grow as the heating goes on.
+#[test]
+fn thermal_cracking_starts_at_the_outer_surface_at_ts() {
+    let p = thermal_cracking::Params::new(thermal_cracking::SIZES[0]);
+    let o = thermal_cracking::run(&cpu(), &p).unwrap();
+    eprintln!(
+        "thermal_cracking: onset σn/Ts {:.4}, σθ(r_o)/Ts {:.4}, r {:.4} m (peak {:.4} m), {} steps",
+        o.onset_ratio, o.outer_ratio, o.onset_radius, o.peak_radius, o.steps
+    );
+    assert!(o.located, "first joint at r = {} m", o.onset_radius);
+    assert!(o.error <= thermal_cracking::TOL, "error {}", o.error);
+    assert!(
+        o.onset_tilt_deg < 30.0,
+        "first crack not radial: {}°",
+        o.onset_tilt_deg
+    );
+    let broken: Vec<usize> = o.snapshots.iter().map(|s| s.broken.len()).collect();
+    assert!(broken.windows(2).all(|w| w[0] <= w[1]), "{broken:?}");
+    assert!(*broken.last().unwrap() > 0, "no joint broke: {broken:?}");
 }

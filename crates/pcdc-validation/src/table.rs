@@ -17,8 +17,8 @@ use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
     block_sliding, brazilian, creep, direct_tension, fracture_flow, half_space_conduction,
-    injection, kirsch, lauwerier, radial_flow, slope_excavation, thermal_cylinder, triaxial,
-    tunnel, ucs, unconfined_flow, vibration_energy, wave_speed,
+    injection, kirsch, lauwerier, radial_flow, slope_excavation, thermal_cracking,
+    thermal_cylinder, triaxial, tunnel, ucs, unconfined_flow, vibration_energy, wave_speed,
 };
 
 /// One measured row of the report.
@@ -133,6 +133,7 @@ pub const CASES: &[&str] = &[
     "half_space_conduction",
     "thermal_cylinder",
     "lauwerier",
+    "thermal_cracking",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -296,6 +297,11 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("lauwerier", "fluid and rock", size));
             }
         }
+        "thermal_cracking" => {
+            for size in thermal_cracking::SIZES {
+                out.push(j("thermal_cracking", "onset", size));
+            }
+        }
         // Homogeneous blocks: the mesh changes the cost, not the closed form.
         "creep" => {
             for size in [0.05, 0.025, 0.0125] {
@@ -450,6 +456,23 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
         "lauwerier" => {
             let o = lauwerier::run(backend, &lauwerier::Params { size: job.size })?;
             within(o.elements, o.error, lauwerier::TOL, o.steps)
+        }
+        "thermal_cracking" => {
+            let o = thermal_cracking::run(backend, &thermal_cracking::Params::new(job.size))?;
+            // The onset error is the row's error; where the first joint softened is in
+            // the tolerance column, and both must pass.
+            row(
+                o.elements,
+                o.error,
+                format!(
+                    "{} % (first joint at r = {:.4} m, σθ peak at {:.4} m)",
+                    thermal_cracking::TOL * 100.0,
+                    o.onset_radius,
+                    o.peak_radius
+                ),
+                o.passes(),
+                o.steps,
+            )
         }
         "thermal_cylinder" => {
             let o = thermal_cylinder::run(backend, &thermal_cylinder::Params { size: job.size })?;
@@ -669,7 +692,10 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
          column; half_space_conduction: largest |T − T_erfc| / (Ts − T0) over every node at \
          two times; thermal_cylinder: largest |σ − σ_exact| of σr, σθ (nodal averages) against \
          eq. 115–116 corrected, over max |σθ|, with the temperature error (fraction of \
-         T_i − T_o) in the tolerance column). Wall time includes the build; \
+         T_i − T_o) in the tolerance column; lauwerier: largest |T − T_exact| / (T_a − T_i) of \
+         the fluid along the fracture and the rock 5 m from it at 50 and 150 days; \
+         thermal_cracking: |σn / Ts − 1| with σn the closed-form normal traction on the \
+         first joint to soften, from the computed temperature field). Wall time includes the build; \
          element-steps/s = elements × steps / wall time (the direct Kirsch solve counts \
          its iterations as steps). GPU rows on a software adapter (Mesa's lavapipe) \
          show that the path works and what it costs there, not GPU speed.\n\n",

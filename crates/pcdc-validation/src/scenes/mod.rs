@@ -25,6 +25,7 @@ pub mod limits;
 pub mod platen_test;
 pub mod radial_flow;
 pub mod slope_excavation;
+pub mod thermal_cracking;
 pub mod thermal_cylinder;
 pub mod triaxial;
 pub mod tunnel;
