@@ -50,8 +50,11 @@ use pcdc_mesh::{builders, split_nodes, Dim2, Range};
 use pcdc_thermal::{HeatMaterial, JointHeat, Thermal};
 
 use crate::report::SceneError;
+// The granite of scene 13 (heat and elasticity).
+use crate::scenes::thermal_cylinder::{ALPHA, CAPACITY, DENSITY, K, POISSON, YOUNG};
 
-/// Tolerance on |σ_θ(r_o)/T_s − 1| at the onset.
+/// Tolerance on |σ_n/T_s − 1| at the onset (σ_n the closed-form normal traction on the
+/// first joint to soften).
 pub const TOL: f64 = 0.10;
 /// Inner and outer radius (m).
 pub const R_IN: f64 = 0.02;
@@ -61,12 +64,6 @@ pub const R_OUT: f64 = 0.06;
 pub const T_OUT: f64 = 20.0;
 /// Tensile strength of the joints (Pa).
 pub const TS: f64 = 2e6;
-const K: f64 = 3.0;
-const CAPACITY: f64 = 800.0;
-const DENSITY: f64 = 2700.0;
-const YOUNG: f64 = 30e9;
-const POISSON: f64 = 0.25;
-const ALPHA: f64 = 8e-6;
 /// Joint penalties over E: 100 E keeps the joints' elastic compliance (2 h / P_open at
 /// the peak traction, eq. 65) at 2 % of the elements'; 10 E relieved a fifth of the hoop
 /// strain and delayed the onset accordingly.

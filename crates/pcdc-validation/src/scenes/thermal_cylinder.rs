@@ -45,11 +45,11 @@ pub const R_OUT: f64 = 0.3;
 pub const T_IN: f64 = 100.0;
 /// See [`T_IN`].
 pub const T_OUT: f64 = 20.0;
-const K: f64 = 3.0;
-const CAPACITY: f64 = 800.0;
-const DENSITY: f64 = 2700.0;
-const YOUNG: f64 = 30e9;
-const POISSON: f64 = 0.25;
+pub(crate) const K: f64 = 3.0;
+pub(crate) const CAPACITY: f64 = 800.0;
+pub(crate) const DENSITY: f64 = 2700.0;
+pub(crate) const YOUNG: f64 = 30e9;
+pub(crate) const POISSON: f64 = 0.25;
 /// Linear expansion coefficient (1/K).
 pub const ALPHA: f64 = 8e-6;
 const MAX_STEPS: u64 = 2_000_000;
