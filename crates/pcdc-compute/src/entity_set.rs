@@ -41,6 +41,16 @@ impl EntitySet {
         })
     }
 
+    /// Adds `by` to every node index at or above `from` (the engine's shift of a
+    /// physics' added nodes to their simulation indices).
+    pub(crate) fn shift_nodes_from(&mut self, from: u32, by: u32) {
+        for n in &mut self.nodes {
+            if *n >= from {
+                *n += by;
+            }
+        }
+    }
+
     /// The set's name.
     pub fn name(&self) -> &str {
         &self.name

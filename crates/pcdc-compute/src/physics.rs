@@ -374,7 +374,11 @@ pub trait Physics<D: Dim>: Send + Sync {
     /// Entity sets this physics defines (e.g. flow channels, bolt segments), available to
     /// every physics' fields ([`crate::Place::Set`]) and at init
     /// ([`InitContext::entity_set`]). The mesh's interfaces are always the set
-    /// [`crate::names::JOINTS`]. Default: none.
+    /// [`crate::names::JOINTS`]. A set may join nodes this physics adds in `init`
+    /// ([`InitContext::add_nodes`], e.g. bolt nodes): number them from
+    /// `mesh.n_nodes()` in the order they will be added; the engine shifts them to their
+    /// simulation indices before this physics' `init` and checks after it that they
+    /// were added. Default: none.
     fn entity_sets(&self, _mesh: &Mesh<D>) -> Vec<crate::EntitySet> {
         Vec::new()
     }

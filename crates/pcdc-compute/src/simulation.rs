@@ -288,18 +288,21 @@ pub(crate) struct Layout {
 }
 
 /// The mesh's interfaces as the set [`crate::names::JOINTS`], then every physics' own
-/// sets (names unique; node indices within the mesh).
+/// sets (names unique; node indices within the mesh, or from `mesh.n_nodes()` on for the
+/// nodes the physics itself adds), with the index of the physics that declared each set
+/// (`None` for the joints).
 fn entity_sets<D: Dim>(
     mesh: &Mesh<D>,
     physics: &[Box<dyn Physics<D>>],
-) -> Result<Vec<crate::EntitySet>, ComputeError> {
+) -> Result<(Vec<crate::EntitySet>, Vec<Option<usize>>), ComputeError> {
     let joints = mesh.interfaces();
     let mut sets = vec![crate::EntitySet::new(
         crate::names::JOINTS,
         joints.nodes_per_joint().max(1),
         joints.nodes().to_vec(),
     )?];
-    for p in physics {
+    let mut owners = vec![None];
+    for (i, p) in physics.iter().enumerate() {
         for s in p.entity_sets(mesh) {
             if sets.iter().any(|t| t.name() == s.name()) {
                 return Err(ComputeError::param(
@@ -308,17 +311,50 @@ fn entity_sets<D: Dim>(
                     "another set has that name",
                 ));
             }
-            if let Some(&n) = s.nodes().iter().find(|&&n| n as usize >= mesh.n_nodes()) {
-                return Err(ComputeError::param(
-                    format!("entity set '{}' of physics '{}'", s.name(), p.name()),
-                    n,
-                    format!("the mesh has {} nodes", mesh.n_nodes()),
-                ));
-            }
             sets.push(s);
+            owners.push(Some(i));
         }
     }
-    Ok(sets)
+    Ok((sets, owners))
+}
+
+/// Shifts the nodes physics `p` adds in its sets (numbered from the mesh's node count)
+/// to their simulation indices, `first_added` on.
+fn shift_added_nodes(
+    sets: &mut [crate::EntitySet],
+    owners: &[Option<usize>],
+    p: usize,
+    n_mesh: usize,
+    first_added: usize,
+) {
+    for (s, o) in sets.iter_mut().zip(owners) {
+        if *o == Some(p) && first_added > n_mesh {
+            s.shift_nodes_from(n_mesh as u32, (first_added - n_mesh) as u32);
+        }
+    }
+}
+
+/// Checks that every node of physics `p`'s sets exists once it has added its nodes.
+fn check_set_nodes(
+    sets: &[crate::EntitySet],
+    owners: &[Option<usize>],
+    p: usize,
+    name: &str,
+    n_nodes: usize,
+) -> Result<(), ComputeError> {
+    for (s, o) in sets.iter().zip(owners) {
+        if *o != Some(p) {
+            continue;
+        }
+        if let Some(&n) = s.nodes().iter().find(|&&n| n as usize >= n_nodes) {
+            return Err(ComputeError::param(
+                format!("entity set '{}' of physics '{name}'", s.name()),
+                n,
+                format!("the simulation has {n_nodes} nodes (mesh nodes and those physics added)"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Checks the composition's field uses (one owner per field, no use without an owner,
@@ -415,13 +451,14 @@ pub(crate) fn prepare_layout<D: Dim>(
     mesh: &Mesh<D>,
     physics: &mut [Box<dyn Physics<D>>],
 ) -> Result<Layout, ComputeError> {
-    let sets = entity_sets(mesh, physics)?;
+    let (mut sets, owners) = entity_sets(mesh, physics)?;
     let mut fields = declare_fields(mesh, physics, &sets)?;
     let mut slot_ranges = Vec::with_capacity(physics.len());
     let mut slot_nodes = Vec::new();
     let mut coords = mesh.coords().to_vec();
     let mut added_mass = Vec::new();
-    for p in physics.iter_mut() {
+    for (i, p) in physics.iter_mut().enumerate() {
+        shift_added_nodes(&mut sets, &owners, i, mesh.n_nodes(), coords.len() / D::D);
         let mut ctx = InitContext {
             mesh,
             fields: &mut fields,
@@ -437,6 +474,7 @@ pub(crate) fn prepare_layout<D: Dim>(
         slot_ranges.push(first..slot_nodes.len());
         coords.extend_from_slice(&ctx.added_coords);
         added_mass.extend_from_slice(&ctx.added_mass);
+        check_set_nodes(&sets, &owners, i, p.name(), coords.len() / D::D)?;
     }
     let n_nodes = coords.len() / D::D;
     let mut gather_ptr = vec![0u32; n_nodes + 1];

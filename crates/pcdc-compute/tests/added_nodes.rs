@@ -139,3 +139,80 @@ fn gpu_integrates_added_nodes_the_same() {
     let p = 2 * c.mesh().n_nodes();
     assert_eq!(&g.state.u[p..], &c.state.u[p..]);
 }
+
+/// A physics that adds one node and names it in its own entity set, numbered from the
+/// mesh's node count as the trait says.
+struct Tagged {
+    set: &'static str,
+    seen: Option<u32>,
+}
+
+impl Physics<Dim2> for Tagged {
+    fn name(&self) -> &str {
+        self.set
+    }
+    fn entity_sets(&self, mesh: &Mesh<Dim2>) -> Vec<pcdc_compute::EntitySet> {
+        vec![pcdc_compute::EntitySet::new(self.set, 1, vec![mesh.n_nodes() as u32]).unwrap()]
+    }
+    fn init(&mut self, ctx: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
+        let block = ctx.add_nodes(&START, &[MASS])?;
+        // The set already names the node's simulation index.
+        self.seen = Some(ctx.entity_set(self.set).unwrap().nodes()[0]);
+        assert_eq!(self.seen, Some(block.first as u32));
+        Ok(())
+    }
+    fn add_mass(&self, m: &Mesh<Dim2>, _f: &FieldStore, mass: &mut [f64], _s: Option<f64>) {
+        mass[..m.n_nodes()].iter_mut().for_each(|x| *x += 1.0);
+    }
+    fn compute_forces(&mut self, _: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
+        Ok(())
+    }
+}
+
+#[test]
+fn entity_sets_name_added_nodes_by_their_simulation_index() {
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    let n = mesh.n_nodes() as u32;
+    let s = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+        .time_step(DT)
+        .physics(Tagged {
+            set: "first",
+            seen: None,
+        })
+        .physics(Tagged {
+            set: "second",
+            seen: None,
+        })
+        .build()
+        .unwrap();
+    assert_eq!(s.entity_set("first").unwrap().nodes(), &[n]);
+    assert_eq!(s.entity_set("second").unwrap().nodes(), &[n + 1]);
+}
+
+#[test]
+fn a_set_naming_a_node_nobody_added_is_an_error() {
+    struct Liar;
+    impl Physics<Dim2> for Liar {
+        fn name(&self) -> &str {
+            "liar"
+        }
+        fn entity_sets(&self, mesh: &Mesh<Dim2>) -> Vec<pcdc_compute::EntitySet> {
+            vec![pcdc_compute::EntitySet::new("ghosts", 1, vec![mesh.n_nodes() as u32]).unwrap()]
+        }
+        fn init(&mut self, _: &mut InitContext<'_, Dim2>) -> Result<(), ComputeError> {
+            Ok(())
+        }
+        fn compute_forces(&mut self, _: &mut ForceContext<'_, Dim2>) -> Result<(), ComputeError> {
+            Ok(())
+        }
+    }
+    let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.5).unwrap();
+    let e = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+        .time_step(DT)
+        .physics(Liar)
+        .build()
+        .err()
+        .expect("a set naming a missing node must not build")
+        .to_string();
+    assert!(e.contains("entity set 'ghosts'"), "{e}");
+}

@@ -1,0 +1,106 @@
+//! Rock support for pcdc-rs: fully grouted rock bolts and cables (manual 7.9).
+//!
+//! A bolt is a polyline of two-node bar segments with nodes of its own (physics-owned
+//! degrees of freedom with lumped masses, integrated by the same explicit step as the
+//! mesh). Every bolt node is grouted to the element of the reference mesh that holds
+//! it: the host's motion is interpolated at the node with the element's linear shape
+//! functions (barycentric weights), and the grout's force goes back to the host's nodes
+//! with the same weights, so action equals reaction exactly. In an FDEM mesh every
+//! element has its own nodes, so when the host's fragment moves or rotates, its bolt
+//! nodes follow it. No shear or bending stiffness (the manual's assumption): the bolt's
+//! shear resistance across a sliding joint comes from its axial force as the bolt is
+//! stretched and turned.
+//!
+//! # Equations (manual 7.9; corrections marked)
+//!
+//! Axial force of segment i with reference length L_b,i and A_b = π D_b²/4 (eq. 138-142):
+//!
+//! * f*_a = f_a + (E_b A_b / L_b,i) Δu_a (138-139), written in total form
+//!   f*_a = (E_b A_b / L_b,i)(L − L_b,i − u_p) with the plastic elongation u_p, which is
+//!   the same law summed exactly and does not drift when the segment rotates;
+//! * f_a = min(f*_a, f_b,t,l) in tension (140), f_a = max(f*_a, −f_b,c,l) in compression
+//!   (141, [CORRECTED]: the manual prints the tensile yield force in this branch);
+//!   the plastic elongation moves so that the force stays on the limit;
+//! * the segment breaks when (L − L_b,i)/L_b,i ≥ ε_b,t,l (142) and carries nothing from
+//!   then on ([NOT IN MANUAL]: permanently).
+//!
+//! Grout at bolt node n with tributary length l_n = (L_b0 + L_b1)/2 (eq. 143-147):
+//!
+//! * δ = (x_n − x_host)·a, the relative displacement along the bolt's axis a at the node
+//!   (mean direction of its segments) of the node against the host's material point
+//!   where it was grouted; f*_s = K_b,r,s l_n (δ − s_p) (143, in total form with the slip
+//!   s_p);
+//! * |f_s| ≤ S_b l_n (144-145), S_b = min(S_r,g, S_b,g),
+//!   S_r,g = π (D_b + 2 T_g)(C_r,g + σ_n tan φ_r,g) (146), S_b,g = π D_b (C_b,g + σ_n
+//!   tan φ_b,g) (147); σ_n is the host's confining stress across the bolt, the mean
+//!   compressive normal stress over the directions perpendicular to the axis (tension
+//!   gives 0) [NOT IN MANUAL: the manual says "normal stress perpendicular to the
+//!   bolt"]; it is read from the previous step's stress;
+//! * across the axis the grout is an elastic spring k_n l_n per node [NOT IN MANUAL:
+//!   the manual ignores it, which leaves the bolt nodes free to drift sideways; FLAC's
+//!   cable links are rigid across the axis, this is their explicit penalty form;
+//!   `BoltProperties::normal_stiffness`, default K_b,r,s].
+//!
+//! Damping (eq. 148): F = D_b,f C (v_j − v_i)·e on each segment, C = 2 A_b √(E_b ρ_b)
+//! ([CORRECTED]: printed 2 L_b √(E_b ρ_b), which is not a damping coefficient in N·s/m;
+//! applied to the relative axial velocity of the segment's ends, not to the node's
+//! velocity, so that a bolt in a fragment in free flight is not braked).
+//!
+//! Face plate ([NOT IN MANUAL]): a one-sided spring at the head that pushes the head
+//! back out when the bolt pulls it into the rock, with the reaction into the rock.
+//! Pretension ([NOT IN MANUAL]): the segments of the free length start with u_p =
+//! −f_pre L_b,i / (E_b A_b), i.e. shortened so that they carry f_pre when the rock has
+//! not moved; with a face plate the head bears on the rock. 2D spacing ([NOT IN
+//! MANUAL]): a bolt in a 2D (plane-strain) model stands for a row `spacing` apart: its
+//! stiffnesses, strengths, masses, pretension, plate and node forces are divided by the
+//! spacing (per unit thickness), as FLAC smears cables.
+//!
+//! Stable step ([NOT IN MANUAL]): per bolt node, Gershgorin's bound with the hosts held
+//! fixed, ω² ≤ (Σ 2 E_b A_b / L_b,i + max(K_b,r,s, k_n) l_n + k_plate) / m_n, reduced
+//! by √(1 + ζ²) − ζ for the axial damping; it enters the simulation's step like every
+//! other physics' limit and names the limiting bolt node.
+//!
+//! # Composing
+//!
+//! ```rust,ignore
+//! let rebar = BoltMaterial::new(BoltProperties::steel_rebar(0.025))?;
+//! let bolts = Bolts::new()
+//!     .bolt(Bolt::straight("B1", [0.0, 0.0, 0.0], [2.0, 0.0, 0.0], 20, rebar)?)?;
+//! let pull = bolts
+//!     .boundary()
+//!     .force("B1", BoltNodes::Head, [Some((-50e3).into()), None, None])?;
+//! let sim = Simulation::builder(mesh, backend)
+//!     .physics(Mechanics::new().material(Range::All, rock))
+//!     .physics(bolts)
+//!     .physics(pull)
+//!     .build()?;
+//! ```
+//!
+//! Fields (on the entity sets [`BOLT_SEGMENTS`] and [`BOLT_NODES`]): [`BOLT_AXIAL_FORCE`],
+//! [`BOLT_PLASTIC_ELONGATION`], [`BOLT_STATE`], [`BOLT_GROUT_FORCE`], [`BOLT_SLIP`].
+//! Output: [`output::BoltSeries`] writes the bolts as VTU line cells for ParaView,
+//! [`output::axial_force_profile`] gives the force along a bolt for CSV histories.
+//!
+//! What is not here yet: the GPU kernels (a GPU simulation with bolts is refused with
+//! an error naming the physics) and re-locating a bolt node whose host it has left:
+//! the host is found once, in the reference mesh, and its force slots are fixed there.
+
+mod bolt;
+mod boundary;
+mod error;
+mod fields;
+mod host;
+mod material;
+pub mod output;
+mod physics;
+
+pub use bolt::Bolt;
+pub use boundary::BoltNodes;
+pub use error::BoltError;
+pub use fields::*;
+pub use host::{barycentric, Host, Locator};
+pub use material::{grout_force, AxialLaw, BoltMaterial, BoltProperties, SegmentState};
+pub use physics::{BoltBoundary, Bolts};
+
+/// The physics name of [`Bolts`] (errors and stable-step reports name it).
+pub const NAME: &str = "bolts";

@@ -1,0 +1,832 @@
+//! The bolts as one physics: bolt nodes with their own lumped masses, axial bar forces,
+//! grout coupling to the host elements, face plates; and [`BoltBoundary`], the
+//! conditions on bolt nodes (a physics of its own, whose forces count as applied loads).
+
+use pcdc_compute::{
+    names, ComputeError, Entity, EntityKind, EntitySet, FieldId, FieldStore, FieldUse, Fingerprint,
+    ForceContext, InitContext, KinematicNodes, Kinematics, Physics, StableStep, VelocityContext,
+};
+use pcdc_mesh::{Dim, Mesh};
+
+use crate::boundary::{BcKind, BoltBc, BoltNodes, ResolvedBc};
+use crate::fields::*;
+use crate::host::Locator;
+use crate::material::{AxialLaw, SegmentState};
+use crate::{Bolt, BoltError, NAME};
+
+/// A segment: its two simulation nodes, reference length and law.
+#[derive(Clone, Debug)]
+pub(crate) struct Segment {
+    pub n: [u32; 2],
+    pub l0: f64,
+    pub law: AxialLaw,
+    /// Axial damping coefficient (N·s/m).
+    pub damping: f64,
+}
+
+/// A bolt node: its simulation node, host element and weights, the grout's stiffnesses
+/// over its tributary length, its bond factor, neighbouring segments and plate.
+#[derive(Clone, Debug)]
+pub(crate) struct BoltNode {
+    pub node: u32,
+    pub bolt: u32,
+    pub host: u32,
+    pub host_nodes: [u32; 4],
+    pub weights: [f64; 4],
+    /// K_b,r,s l (N/m), 0 on the free length.
+    pub k_axial: f64,
+    /// Lateral grout stiffness × l (N/m).
+    pub k_normal: f64,
+    /// Tributary length over the spacing (m): bond capacity = S_b(σn) × this.
+    pub bond_length: f64,
+    /// Segments before and after (u32::MAX: none).
+    pub prev: u32,
+    pub next: u32,
+    /// Face plate stiffness (N/m), 0 without.
+    pub plate: f64,
+    /// Lumped mass (kg, per unit thickness in 2D).
+    pub mass: f64,
+}
+
+const NONE: u32 = u32::MAX;
+
+/// Fully grouted rock bolts and cables (manual 7.9): compose after the mechanics (the
+/// grout's confinement reads the host elements' stress of the previous step).
+///
+/// Each bolt adds its nodes to the simulation (physics-owned degrees of freedom with
+/// lumped masses ρ_b A_b (L_b0 + L_b1)/2, integrated with the mesh nodes). Per step:
+/// the axial force of every segment (eq. 138-142), the grout force at every bolt node
+/// against its host element's motion interpolated at the node (eq. 143-147), the
+/// reaction to the host's nodes with the same weights (action = reaction exactly), the
+/// face plate at the head, and the axial damping (eq. 148). See the crate docs.
+#[derive(Clone)]
+pub struct Bolts {
+    bolts: Vec<Bolt>,
+    segments: Vec<Segment>,
+    nodes: Vec<BoltNode>,
+    /// First bolt-node and segment index of each bolt.
+    node_offset: Vec<usize>,
+    segment_offset: Vec<usize>,
+    ids: Option<Ids>,
+    /// Work buffer: segment force vectors (stride 3).
+    seg_force: Vec<[f64; 3]>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Ids {
+    axial: FieldId,
+    plastic: FieldId,
+    state: FieldId,
+    grout: FieldId,
+    slip: FieldId,
+    stress: FieldId,
+    rotation: Option<FieldId>,
+}
+
+impl Default for Bolts {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Bolts {
+    /// No bolts yet.
+    pub fn new() -> Self {
+        Bolts {
+            bolts: Vec::new(),
+            segments: Vec::new(),
+            nodes: Vec::new(),
+            node_offset: Vec::new(),
+            segment_offset: Vec::new(),
+            ids: None,
+            seg_force: Vec::new(),
+        }
+    }
+
+    /// Adds a bolt. Errors if another bolt has its name.
+    pub fn bolt(mut self, bolt: Bolt) -> Result<Self, BoltError> {
+        if self.bolts.iter().any(|b| b.name() == bolt.name()) {
+            return Err(BoltError::Geometry {
+                bolt: bolt.name().to_string(),
+                reason: "another bolt has that name".into(),
+            });
+        }
+        self.bolts.push(bolt);
+        Ok(self)
+    }
+
+    /// The bolts, in the order added.
+    pub fn bolts(&self) -> &[Bolt] {
+        &self.bolts
+    }
+
+    /// Index of the first node of bolt `b` in the set [`BOLT_NODES`] and its node count.
+    pub fn node_range(&self, b: usize) -> std::ops::Range<usize> {
+        let first: usize = self.bolts[..b].iter().map(|x| x.points().len()).sum();
+        first..first + self.bolts[b].points().len()
+    }
+
+    /// Index of the first segment of bolt `b` in the set [`BOLT_SEGMENTS`] and its
+    /// segment count.
+    pub fn segment_range(&self, b: usize) -> std::ops::Range<usize> {
+        let first: usize = self.bolts[..b].iter().map(|x| x.segments()).sum();
+        first..first + self.bolts[b].segments()
+    }
+
+    /// A boundary physics for bolt nodes of these bolts (compose it after them).
+    pub fn boundary(&self) -> BoltBoundary {
+        BoltBoundary {
+            bolts: self
+                .bolts
+                .iter()
+                .enumerate()
+                .map(|(b, x)| {
+                    let s = x.material().properties().spacing.unwrap_or(1.0);
+                    (x.name().to_string(), self.node_range(b), s)
+                })
+                .collect(),
+            items: Vec::new(),
+            resolved: Vec::new(),
+            accel: None,
+        }
+    }
+
+    /// Builds segments and nodes (hosts located in the reference mesh).
+    fn build<D: Dim>(&mut self, mesh: &Mesh<D>, first: usize) -> Result<(), BoltError> {
+        let d = D::D;
+        let two_d = d == 2;
+        let locator = Locator::new(mesh);
+        self.segments.clear();
+        self.nodes.clear();
+        self.node_offset.clear();
+        self.segment_offset.clear();
+        let mut node = first as u32;
+        for (b, bolt) in self.bolts.iter().enumerate() {
+            let props = bolt.material().properties();
+            if !two_d && props.spacing.is_some() {
+                return Err(BoltError::param(
+                    format!("spacing of bolt '{}'", bolt.name()),
+                    props.spacing.unwrap_or(1.0),
+                    "applies to 2D models only (a 3D model places every bolt)",
+                ));
+            }
+            let eff = bolt.material().effective(two_d);
+            let pts = bolt.points();
+            let n = pts.len();
+            self.node_offset.push(self.nodes.len());
+            self.segment_offset.push(self.segments.len());
+            let seg0 = self.segments.len() as u32;
+            for s in 0..n - 1 {
+                self.segments.push(Segment {
+                    n: [node + s as u32, node + s as u32 + 1],
+                    l0: bolt.segment_length(s),
+                    law: eff.axial,
+                    damping: eff.damping,
+                });
+            }
+            let free = bolt.free();
+            for (k, pt) in pts.iter().enumerate() {
+                let lp = if k > 0 {
+                    bolt.segment_length(k - 1)
+                } else {
+                    0.0
+                };
+                let ln = if k + 1 < n {
+                    bolt.segment_length(k)
+                } else {
+                    0.0
+                };
+                let l = 0.5 * (lp + ln);
+                let grouted = free <= 0.0 || bolt.arc_length(k) >= free * (1.0 - 1e-9);
+                let host =
+                    locator
+                        .locate(&pt[..d], 1e-9)
+                        .ok_or_else(|| BoltError::OutsideMesh {
+                            bolt: bolt.name().to_string(),
+                            node: k,
+                            position: pt[..d].to_vec(),
+                        })?;
+                let mut host_nodes = [0u32; 4];
+                host_nodes[..=d].copy_from_slice(mesh.element(host.element));
+                self.nodes.push(BoltNode {
+                    node: node + k as u32,
+                    bolt: b as u32,
+                    host: host.element as u32,
+                    host_nodes,
+                    weights: host.weights,
+                    k_axial: if grouted { eff.shear * l } else { 0.0 },
+                    k_normal: eff.normal * l,
+                    bond_length: l * eff.bond_per_spacing,
+                    prev: if k > 0 { seg0 + k as u32 - 1 } else { NONE },
+                    next: if k + 1 < n { seg0 + k as u32 } else { NONE },
+                    plate: if k == 0 {
+                        bolt.plate().map_or(0.0, |p| p * eff.bond_per_spacing)
+                    } else {
+                        0.0
+                    },
+                    mass: eff.mass_per_length * l,
+                });
+            }
+            node += n as u32;
+        }
+        Ok(())
+    }
+
+    /// Whether segment `s` lies in its bolt's free length (its midpoint does).
+    fn segment_is_free(&self, b: usize, local: usize) -> bool {
+        let bolt = &self.bolts[b];
+        let mid = bolt.arc_length(local) + 0.5 * bolt.segment_length(local);
+        mid < bolt.free()
+    }
+}
+
+/// Confining stress normal to the bolt at its host (Pa, ≥ 0, compression): the mean
+/// normal stress over the directions perpendicular to the axis `a` (global), from the
+/// host's co-rotated stress `s` (xx, yy, xy in 2D; xx, yy, zz, xy, yz, xz in 3D) and
+/// its rotation (2D: the angle of the host's polar decomposition from the positions;
+/// 3D: the mechanics' rotation matrix R, global = R σ Rᵀ).
+fn confinement(d: usize, s: &[f64], a: &[f64; 3], rot: &[f64]) -> f64 {
+    let (trace, saa) = if d == 2 {
+        let (c, sn) = (rot[0], rot[1]);
+        // a_c = Rᵀ a with R = [[c, −s], [s, c]].
+        let ac = [c * a[0] + sn * a[1], -sn * a[0] + c * a[1]];
+        (
+            s[0] + s[1],
+            ac[0] * ac[0] * s[0] + ac[1] * ac[1] * s[1] + 2.0 * ac[0] * ac[1] * s[2],
+        )
+    } else {
+        let ac: [f64; 3] =
+            std::array::from_fn(|i| rot[i] * a[0] + rot[3 + i] * a[1] + rot[6 + i] * a[2]);
+        (
+            s[0] + s[1] + s[2],
+            ac[0] * ac[0] * s[0]
+                + ac[1] * ac[1] * s[1]
+                + ac[2] * ac[2] * s[2]
+                + 2.0 * (ac[0] * ac[1] * s[3] + ac[1] * ac[2] * s[4] + ac[0] * ac[2] * s[5]),
+        )
+    };
+    (-(trace - saa) / (d - 1) as f64).max(0.0)
+}
+
+/// cos and sin of the rotation of a triangle from its reference to its current
+/// positions (the polar decomposition's angle of F = Dx Dm⁻¹).
+fn rotation_2d(xr: &[f64], xc: &[f64]) -> [f64; 2] {
+    let dm = [xr[2] - xr[0], xr[4] - xr[0], xr[3] - xr[1], xr[5] - xr[1]];
+    let dx = [xc[2] - xc[0], xc[4] - xc[0], xc[3] - xc[1], xc[5] - xc[1]];
+    let det = dm[0] * dm[3] - dm[1] * dm[2];
+    let inv = [dm[3] / det, -dm[1] / det, -dm[2] / det, dm[0] / det];
+    let f = [
+        dx[0] * inv[0] + dx[1] * inv[2],
+        dx[0] * inv[1] + dx[1] * inv[3],
+        dx[2] * inv[0] + dx[3] * inv[2],
+        dx[2] * inv[1] + dx[3] * inv[3],
+    ];
+    let (y, x) = (f[2] - f[1], f[0] + f[3]);
+    let r = (x * x + y * y).sqrt();
+    if r > 0.0 {
+        [x / r, y / r]
+    } else {
+        [1.0, 0.0]
+    }
+}
+
+fn unit(v: [f64; 3]) -> ([f64; 3], f64) {
+    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if l > 0.0 {
+        ([v[0] / l, v[1] / l, v[2] / l], l)
+    } else {
+        ([0.0; 3], 0.0)
+    }
+}
+
+impl<D: Dim> Physics<D> for Bolts {
+    fn name(&self) -> &str {
+        NAME
+    }
+
+    fn entity_sets(&self, mesh: &Mesh<D>) -> Vec<EntitySet> {
+        // Added nodes are numbered from the mesh's node count (the engine shifts them).
+        let first = mesh.n_nodes() as u32;
+        let mut seg = Vec::new();
+        let mut nodes = Vec::new();
+        let mut n = first;
+        for b in &self.bolts {
+            for s in 0..b.segments() as u32 {
+                seg.extend_from_slice(&[n + s, n + s + 1]);
+            }
+            nodes.extend(n..n + b.points().len() as u32);
+            n += b.points().len() as u32;
+        }
+        vec![
+            EntitySet::new(BOLT_SEGMENTS, 2, seg).expect("two nodes per segment"),
+            EntitySet::new(BOLT_NODES, 1, nodes).expect("one node per entity"),
+        ]
+    }
+
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
+        let mut f = vec![
+            BOLT_AXIAL_FORCE.own::<D>(),
+            BOLT_PLASTIC_ELONGATION.own::<D>(),
+            BOLT_STATE.own::<D>(),
+            BOLT_GROUT_FORCE.own::<D>(),
+            BOLT_SLIP.own::<D>(),
+            names::STRESS.read_lagged::<D>(),
+        ];
+        if D::D == 3 {
+            f.push(names::ROTATION.read_lagged::<D>());
+        }
+        f
+    }
+
+    fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
+        if self.bolts.is_empty() {
+            return Err(ComputeError::param(
+                "bolts",
+                0,
+                "add at least one bolt (Bolts::bolt)",
+            ));
+        }
+        let d = D::D;
+        let first = ctx.n_nodes();
+        self.build(ctx.mesh, first)?;
+        let mut coords = Vec::with_capacity(self.nodes.len() * d);
+        for b in &self.bolts {
+            for p in b.points() {
+                coords.extend_from_slice(&p[..d]);
+            }
+        }
+        let mass: Vec<f64> = self.nodes.iter().map(|n| n.mass).collect();
+        let block = ctx.add_nodes(&coords, &mass)?;
+        debug_assert_eq!(block.first, first);
+        // Slots: per bolt node, the node itself then its host's nodes.
+        let mut slot_nodes = Vec::with_capacity(self.nodes.len() * (d + 2));
+        for n in &self.nodes {
+            slot_nodes.push(n.node);
+            slot_nodes.extend_from_slice(&n.host_nodes[..=d]);
+        }
+        ctx.register_slots(&slot_nodes)?;
+        let ids = Ids {
+            axial: ctx.fields.id(BOLT_AXIAL_FORCE)?,
+            plastic: ctx.fields.id(BOLT_PLASTIC_ELONGATION)?,
+            state: ctx.fields.id(BOLT_STATE)?,
+            grout: ctx.fields.id(BOLT_GROUT_FORCE)?,
+            slip: ctx.fields.id(BOLT_SLIP)?,
+            stress: ctx.fields.id(names::STRESS)?,
+            rotation: if d == 3 {
+                Some(ctx.fields.id(names::ROTATION)?)
+            } else {
+                None
+            },
+        };
+        // Pretension: the free segments' natural length is shorter by f_pre L0 / EA.
+        let mut plastic = vec![0.0; self.segments.len()];
+        for (b, bolt) in self.bolts.iter().enumerate() {
+            let pre = bolt.material().effective(d == 2).pretension;
+            for local in 0..bolt.segments() {
+                if pre > 0.0 && self.segment_is_free(b, local) {
+                    let s = &self.segments[self.segment_offset[b] + local];
+                    plastic[self.segment_offset[b] + local] = -pre * s.l0 / s.law.ea;
+                }
+            }
+        }
+        ctx.fields.get_mut(ids.plastic).copy_from_slice(&plastic);
+        self.ids = Some(ids);
+        self.seg_force = vec![[0.0; 3]; self.segments.len()];
+        Ok(())
+    }
+
+    fn add_mass(&self, _mesh: &Mesh<D>, _f: &FieldStore, mass: &mut [f64], scale: Option<f64>) {
+        // Physical masses came with the nodes (InitContext::add_nodes). For static
+        // relaxation's mass scaling (critical step `t` everywhere): each bolt node gets
+        // m = S t² / 4 with S its Gershgorin row sum, and each host node the row sum the
+        // grout adds to it, 2 k w_q (the grout couples it to the bolt node and to the
+        // host's other nodes with weights summing to 1). Doubled: Gershgorin's bound is
+        // tight for a bar chain's zig-zag mode, and the relaxation's local damping can
+        // add up to the force's own magnitude to it (α ≤ 1), which made it diverge.
+        let Some(t) = scale else { return };
+        let q = 2.0 * t * t / 4.0;
+        let d = D::D;
+        for n in &self.nodes {
+            let k = n.k_axial.max(n.k_normal) + n.plate;
+            let mut s = k;
+            for seg in [n.prev, n.next] {
+                if seg != NONE {
+                    let seg = &self.segments[seg as usize];
+                    s += 2.0 * seg.law.ea / seg.l0;
+                }
+            }
+            mass[n.node as usize] += s * q;
+            for a in 0..=d {
+                mass[n.host_nodes[a] as usize] += 2.0 * k * n.weights[a].abs() * q;
+            }
+        }
+    }
+
+    fn stable_step(&self, _kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
+        // Gershgorin per bolt node (hosts taken as fixed): ω² ≤ (Σ 2 EA/L₀ + k_grout +
+        // k_plate) / m; axial damping lowers the step by √(1 + ζ²) − ζ.
+        let mut best: Option<StableStep> = None;
+        for (i, n) in self.nodes.iter().enumerate() {
+            let (mut k, mut c) = (n.k_axial.max(n.k_normal) + n.plate, 0.0);
+            for s in [n.prev, n.next] {
+                if s != NONE {
+                    let seg = &self.segments[s as usize];
+                    k += 2.0 * seg.law.ea / seg.l0;
+                    c += 2.0 * seg.damping;
+                }
+            }
+            let omega = (k / n.mass).sqrt();
+            let zeta = c / (2.0 * n.mass * omega);
+            let dt = 2.0 / omega * ((1.0 + zeta * zeta).sqrt() - zeta);
+            if best.as_ref().is_none_or(|b| dt < b.dt) {
+                best = Some(StableStep {
+                    dt,
+                    entity: Entity::new(EntityKind::Other("bolt node"), i),
+                    physics: NAME.into(),
+                });
+            }
+        }
+        best
+    }
+
+    fn writes_all_slots(&self) -> bool {
+        true
+    }
+
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+        let d = D::D;
+        let ids = self.ids.expect("init ran");
+        let kin = &ctx.kin;
+        // Segments: axial force (total form) plus damping on the relative velocity.
+        {
+            let [axial, plastic, state] =
+                ctx.fields.get_many_mut([ids.axial, ids.plastic, ids.state]);
+            for (s, seg) in self.segments.iter().enumerate() {
+                let (x0, x1) = (
+                    kin.position(seg.n[0] as usize),
+                    kin.position(seg.n[1] as usize),
+                );
+                let (e, l) = unit(std::array::from_fn(|k| x1[k] - x0[k]));
+                let broken = SegmentState::from_value(state[s]) == SegmentState::Broken;
+                let (f, up, st) = seg.law.update(l - seg.l0, seg.l0, plastic[s], broken);
+                axial[s] = f;
+                plastic[s] = up;
+                state[s] = st as i32 as f64;
+                let mut total = f;
+                if seg.damping > 0.0 && st != SegmentState::Broken {
+                    let (a, b) = (seg.n[0] as usize * d, seg.n[1] as usize * d);
+                    let rel: f64 = (0..d).map(|k| (kin.v[b + k] - kin.v[a + k]) * e[k]).sum();
+                    total += seg.damping * rel;
+                }
+                self.seg_force[s] = [total * e[0], total * e[1], total * e[2]];
+            }
+        }
+        let stress = ctx.fields.get(ids.stress).to_vec();
+        let rotation = ids.rotation.map(|r| ctx.fields.get(r).to_vec());
+        let [grout, slip] = ctx.fields.get_many_mut([ids.grout, ids.slip]);
+        let nsym = D::NSYM;
+        let stride = d + 2;
+        let mut xr = [0.0; 12];
+        let mut xc = [0.0; 12];
+        for (i, n) in self.nodes.iter().enumerate() {
+            let material = self.bolts[n.bolt as usize].material();
+            // Bar forces on the node: +f e as the start of the next segment, −f e as the
+            // end of the previous one (fixed order: previous, next).
+            let mut f = [0.0; 3];
+            if n.prev != NONE {
+                let g = self.seg_force[n.prev as usize];
+                (0..3).for_each(|k| f[k] -= g[k]);
+            }
+            if n.next != NONE {
+                let g = self.seg_force[n.next as usize];
+                (0..3).for_each(|k| f[k] += g[k]);
+            }
+            // Axis at the node: mean of the adjacent segments' current directions.
+            let xb = kin.position(n.node as usize);
+            let mut axis = [0.0; 3];
+            for (s, sign) in [(n.prev, 1.0), (n.next, 1.0)] {
+                if s != NONE {
+                    let seg = &self.segments[s as usize];
+                    let (x0, x1) = (
+                        kin.position(seg.n[0] as usize),
+                        kin.position(seg.n[1] as usize),
+                    );
+                    let (e, _) = unit(std::array::from_fn(|k| x1[k] - x0[k]));
+                    (0..3).for_each(|k| axis[k] += sign * e[k]);
+                }
+            }
+            let (a, _) = unit(axis);
+            // The host's material point where the node was grouted.
+            let mut xh = [0.0; 3];
+            for q in 0..=d {
+                let p = kin.position(n.host_nodes[q] as usize);
+                (0..d).for_each(|k| xh[k] += n.weights[q] * p[k]);
+            }
+            let r: [f64; 3] = std::array::from_fn(|k| xb[k] - xh[k]);
+            let delta: f64 = (0..3).map(|k| r[k] * a[k]).sum();
+            // Grout along the axis: bond-slip with the host's confinement.
+            let mut fs = 0.0;
+            if n.k_axial > 0.0 {
+                let e = n.host as usize;
+                let rot = if d == 2 {
+                    for q in 0..3 {
+                        let node = n.host_nodes[q] as usize;
+                        xr[2 * q..2 * q + 2].copy_from_slice(&kin.coords[2 * node..2 * node + 2]);
+                        let p = kin.position(node);
+                        xc[2 * q..2 * q + 2].copy_from_slice(&p[..2]);
+                    }
+                    rotation_2d(&xr[..6], &xc[..6]).to_vec()
+                } else {
+                    rotation.as_ref().expect("3D reads the rotation")[9 * e..9 * e + 9].to_vec()
+                };
+                let sn = confinement(d, &stress[nsym * e..nsym * (e + 1)], &a, &rot);
+                let cap = material.bond_strength(sn) * n.bond_length;
+                let (force, s) = crate::material::grout_force(delta, slip[i], n.k_axial, cap);
+                fs = force;
+                slip[i] = s;
+            }
+            grout[i] = fs;
+            // Lateral grout, and the face plate (one-sided, pushes the head back out).
+            let mut g: [f64; 3] =
+                std::array::from_fn(|k| fs * a[k] + n.k_normal * (r[k] - delta * a[k]));
+            if n.plate > 0.0 && delta > 0.0 {
+                (0..3).for_each(|k| g[k] += n.plate * delta * a[k]);
+            }
+            let base = i * stride * d;
+            for k in 0..d {
+                ctx.slots[base + k] = f[k] - g[k];
+            }
+            for q in 0..=d {
+                let o = base + (q + 1) * d;
+                for (k, gk) in g.iter().enumerate().take(d) {
+                    ctx.slots[o + k] = n.weights[q] * gk;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn stored_energy(&self, kin: &Kinematics<'_, D>, fields: &FieldStore) -> f64 {
+        // Elastic energy of the bars and of the grout springs at the current state.
+        let Some(ids) = self.ids else { return 0.0 };
+        let axial = fields.get(ids.axial);
+        let grout = fields.get(ids.grout);
+        let mut e = 0.0;
+        for (s, seg) in self.segments.iter().enumerate() {
+            e += 0.5 * axial[s] * axial[s] * seg.l0 / seg.law.ea;
+        }
+        let d = D::D;
+        for (i, n) in self.nodes.iter().enumerate() {
+            if n.k_axial > 0.0 {
+                e += 0.5 * grout[i] * grout[i] / n.k_axial;
+            }
+            let xb = kin.position(n.node as usize);
+            let mut xh = [0.0; 3];
+            for q in 0..=d {
+                let p = kin.position(n.host_nodes[q] as usize);
+                (0..d).for_each(|k| xh[k] += n.weights[q] * p[k]);
+            }
+            let r2: f64 = (0..d).map(|k| (xb[k] - xh[k]).powi(2)).sum();
+            e += 0.5 * n.k_normal * r2;
+        }
+        e
+    }
+
+    fn check_fields(&self, fields: &FieldStore) -> Result<(), ComputeError> {
+        let Some(ids) = self.ids else { return Ok(()) };
+        if let Some(v) = fields
+            .get(ids.state)
+            .iter()
+            .find(|v| !(**v >= 0.0 && **v <= 3.0 && v.fract() == 0.0))
+        {
+            return Err(ComputeError::SnapshotCorrupt(format!(
+                "bolt segment state {v} is not one of 0, 1, 2, 3"
+            )));
+        }
+        Ok(())
+    }
+
+    fn fingerprint(&self) -> u64 {
+        // The bolts' geometry and properties (Debug prints every value exactly).
+        let mut f = Fingerprint::new();
+        for b in &self.bolts {
+            f = f.debug(b);
+        }
+        f.finish()
+    }
+
+    fn slot_entity(&self, slot: usize) -> Option<String> {
+        // Slots per bolt node: the node, then its host's D + 1 nodes.
+        let n = self.nodes.get(slot / (D::D + 2))?;
+        let b = &self.bolts[n.bolt as usize];
+        let k = n.node as usize - self.nodes[self.node_offset[n.bolt as usize]].node as usize;
+        Some(format!("bolt '{}' node {k}", b.name()))
+    }
+}
+
+/// Boundary conditions on bolt nodes (manual 7.9.4, tables 20-21), made by
+/// [`Bolts::boundary`] and composed after the bolts. Forces count as applied loads in
+/// the energy balance.
+pub struct BoltBoundary {
+    /// Name, range in the bolt-node set and spacing of every bolt.
+    bolts: Vec<(String, std::ops::Range<usize>, f64)>,
+    items: Vec<BoltBc>,
+    resolved: Vec<ResolvedBc>,
+    accel: Option<FieldId>,
+}
+
+impl BoltBoundary {
+    fn add(
+        mut self,
+        bolt: &str,
+        nodes: BoltNodes,
+        kind: BcKind,
+        values: [Option<pcdc_compute::TimeValue>; 3],
+    ) -> Result<Self, BoltError> {
+        let Some((_, range, _)) = self.bolts.iter().find(|(n, _, _)| n == bolt) else {
+            return Err(BoltError::Geometry {
+                bolt: bolt.to_string(),
+                reason: "a boundary condition names a bolt that does not exist".into(),
+            });
+        };
+        for (k, v) in values.iter().enumerate() {
+            if let Some(v) = v {
+                v.check(&format!("bolt '{bolt}' boundary component {k}"))?;
+            }
+        }
+        let item = BoltBc {
+            bolt: bolt.to_string(),
+            nodes,
+            kind,
+            values,
+        };
+        item.local_nodes(range.len())?;
+        self.items.push(item);
+        Ok(self)
+    }
+
+    /// Prescribed velocity (m/s) per component (`None`: free) on `nodes` of `bolt`.
+    pub fn velocity(
+        self,
+        bolt: &str,
+        nodes: BoltNodes,
+        values: [Option<pcdc_compute::TimeValue>; 3],
+    ) -> Result<Self, BoltError> {
+        self.add(bolt, nodes, BcKind::Velocity, values)
+    }
+
+    /// Prescribed acceleration (m/s²) per component; the velocity is integrated from
+    /// rest.
+    pub fn acceleration(
+        self,
+        bolt: &str,
+        nodes: BoltNodes,
+        values: [Option<pcdc_compute::TimeValue>; 3],
+    ) -> Result<Self, BoltError> {
+        self.add(bolt, nodes, BcKind::Acceleration, values)
+    }
+
+    /// A force (N, per bolt: divided by the spacing in 2D) on each of `nodes`.
+    pub fn force(
+        self,
+        bolt: &str,
+        nodes: BoltNodes,
+        values: [Option<pcdc_compute::TimeValue>; 3],
+    ) -> Result<Self, BoltError> {
+        self.add(bolt, nodes, BcKind::Force, values)
+    }
+
+    fn kinematic(&self) -> impl Iterator<Item = &ResolvedBc> {
+        self.resolved.iter().filter(|r| r.kind != BcKind::Force)
+    }
+}
+
+impl<D: Dim> Physics<D> for BoltBoundary {
+    fn name(&self) -> &str {
+        "bolt boundary"
+    }
+
+    fn fields(&self, _mesh: &Mesh<D>) -> Vec<FieldUse> {
+        if self.items.iter().any(|i| i.kind == BcKind::Acceleration) {
+            vec![BOLT_BC_VELOCITY.own::<D>()]
+        } else {
+            Vec::new()
+        }
+    }
+
+    fn init(&mut self, ctx: &mut InitContext<'_, D>) -> Result<(), ComputeError> {
+        let set = ctx.entity_set(BOLT_NODES).ok_or_else(|| {
+            ComputeError::param(
+                "bolt boundary",
+                BOLT_NODES,
+                "no bolts are composed before it: compose the Bolts it was made from first",
+            )
+        })?;
+        let two_d = D::D == 2;
+        self.resolved.clear();
+        let mut slot_nodes = Vec::new();
+        for item in &self.items {
+            let (_, range, spacing) = self
+                .bolts
+                .iter()
+                .find(|(n, _, _)| *n == item.bolt)
+                .expect("checked when added");
+            if range.end > set.len() {
+                return Err(ComputeError::param(
+                    "bolt boundary",
+                    &item.bolt,
+                    "made from other bolts than those composed",
+                ));
+            }
+            let nodes: Vec<(u32, u32)> = item
+                .local_nodes(range.len())?
+                .into_iter()
+                .map(|k| (set.nodes()[range.start + k], (range.start + k) as u32))
+                .collect();
+            if item.kind == BcKind::Force {
+                slot_nodes.extend(nodes.iter().map(|n| n.0));
+            }
+            self.resolved.push(ResolvedBc {
+                kind: item.kind,
+                nodes,
+                values: item.values.clone(),
+                scale: if two_d { 1.0 / spacing } else { 1.0 },
+            });
+        }
+        ctx.register_slots(&slot_nodes)?;
+        self.accel = if self.items.iter().any(|i| i.kind == BcKind::Acceleration) {
+            Some(ctx.fields.id(BOLT_BC_VELOCITY)?)
+        } else {
+            None
+        };
+        Ok(())
+    }
+
+    fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+        let d = D::D;
+        let t = ctx.kin.time;
+        let mut slot = 0;
+        for r in self.resolved.iter().filter(|r| r.kind == BcKind::Force) {
+            for _ in &r.nodes {
+                for k in 0..d {
+                    ctx.slots[slot * d + k] =
+                        r.values[k].as_ref().map_or(0.0, |v| v.at(t)) * r.scale;
+                }
+                slot += 1;
+            }
+        }
+        Ok(())
+    }
+
+    fn writes_all_slots(&self) -> bool {
+        true
+    }
+
+    fn applies_loads(&self) -> bool {
+        true
+    }
+
+    fn kinematic_nodes(&self) -> KinematicNodes {
+        let nodes: Vec<u32> = self
+            .kinematic()
+            .flat_map(|r| r.nodes.iter().map(|n| n.0))
+            .collect();
+        if nodes.is_empty() {
+            KinematicNodes::None
+        } else {
+            KinematicNodes::Nodes(nodes)
+        }
+    }
+
+    fn apply_kinematics(&mut self, ctx: &mut VelocityContext<'_, D>) {
+        let d = D::D;
+        let t = ctx.time;
+        for r in &self.resolved {
+            match r.kind {
+                BcKind::Force => {}
+                BcKind::Velocity => {
+                    for &(n, _) in &r.nodes {
+                        for k in 0..d {
+                            if let Some(v) = &r.values[k] {
+                                ctx.v[n as usize * d + k] = v.at(t);
+                            }
+                        }
+                    }
+                }
+                BcKind::Acceleration => {
+                    let id = self.accel.expect("declared with accelerations");
+                    let acc = ctx.fields.get_mut(id);
+                    for &(n, b) in &r.nodes {
+                        for k in 0..d {
+                            if let Some(v) = &r.values[k] {
+                                let w = &mut acc[b as usize * d + k];
+                                *w += v.at(t) * ctx.dt;
+                                ctx.v[n as usize * d + k] = *w;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
