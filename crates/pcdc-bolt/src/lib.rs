@@ -81,14 +81,19 @@
 //! Output: [`output::BoltSeries`] writes the bolts as VTU line cells for ParaView,
 //! [`output::axial_force_profile`] gives the force along a bolt for CSV histories.
 //!
-//! What is not here yet: the GPU kernels (a GPU simulation with bolts is refused with
-//! an error naming the physics) and re-locating a bolt node whose host it has left:
-//! the host is found once, in the reference mesh, and its force slots are fixed there.
+//! On the GPU the bolts run as two force-phase kernels (segments, then nodes: each node
+//! gathers its two segments in a fixed order and writes its own and its host's slots),
+//! with the CPU's arithmetic in the same order and no float atomics.
+//!
+//! Not here: re-locating a bolt node whose host it has left: the host is found once, in
+//! the reference mesh, and its force slots are fixed there (the engine's gather is built
+//! once), so a node that slips further than its host element stays tied to it.
 
 mod bolt;
 mod boundary;
 mod error;
 mod fields;
+mod gpu;
 mod host;
 mod material;
 pub mod output;

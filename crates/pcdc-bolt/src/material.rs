@@ -221,16 +221,22 @@ impl BoltMaterial {
     /// confining (compressive) stress `sigma_n` ≥ 0 (Pa) normal to the bolt:
     /// S_r,g = π (D_b + 2 T_g)(C_r,g + σ_n tan φ_r,g), S_b,g = π D_b (C_b,g + σ_n tan φ_b,g).
     pub fn bond_strength(&self, sigma_n: f64) -> f64 {
+        bond_strength(&self.bond_constants(), sigma_n)
+    }
+
+    /// The constants of eq. 146-147: π (D_b + 2 T_g), C_r,g, tan φ_r,g, π D_b, C_b,g,
+    /// tan φ_b,g.
+    pub(crate) fn bond_constants(&self) -> [f64; 6] {
         let p = &self.p;
-        let s = sigma_n.max(0.0);
         let pi = std::f64::consts::PI;
-        let rock = pi
-            * (p.diameter + 2.0 * p.grout_thickness)
-            * (p.cohesion_rock_grout + s * p.friction_rock_grout.to_radians().tan());
-        let bolt = pi
-            * p.diameter
-            * (p.cohesion_grout_bolt + s * p.friction_grout_bolt.to_radians().tan());
-        rock.min(bolt)
+        [
+            pi * (p.diameter + 2.0 * p.grout_thickness),
+            p.cohesion_rock_grout,
+            p.friction_rock_grout.to_radians().tan(),
+            pi * p.diameter,
+            p.cohesion_grout_bolt,
+            p.friction_grout_bolt.to_radians().tan(),
+        ]
     }
 
     /// The values a segment or node uses, per unit thickness in 2D (divided by the
@@ -354,6 +360,14 @@ impl AxialLaw {
             (trial, plastic, SegmentState::Elastic)
         }
     }
+}
+
+/// Bond strength per unit length (N/m, eq. 144-147) from the constants `b` of
+/// [`BoltMaterial::bond_constants`] under a confining stress `sigma_n` (Pa; negative
+/// values count as 0).
+pub(crate) fn bond_strength(b: &[f64; 6], sigma_n: f64) -> f64 {
+    let s = sigma_n.max(0.0);
+    (b[0] * (b[1] + s * b[2])).min(b[3] * (b[4] + s * b[5]))
 }
 
 /// Grout shear force at a bolt node along the bolt (eq. 143-145), in total form: with

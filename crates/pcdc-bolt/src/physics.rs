@@ -18,6 +18,8 @@ use crate::{Bolt, BoltError, NAME};
 #[derive(Clone, Debug)]
 pub(crate) struct Segment {
     pub n: [u32; 2],
+    /// Reference vector from node 0 to node 1 (m; z = 0 in 2D).
+    pub dx: [f64; 3],
     pub l0: f64,
     pub law: AxialLaw,
     /// Axial damping coefficient (N·s/m).
@@ -39,6 +41,9 @@ pub(crate) struct BoltNode {
     pub k_normal: f64,
     /// Tributary length over the spacing (m): bond capacity = S_b(σn) × this.
     pub bond_length: f64,
+    /// Bond constants (eq. 146-147): π (D_b + 2 T_g), C_r,g, tan φ_r,g, π D_b, C_b,g,
+    /// tan φ_b,g.
+    pub bond: [f64; 6],
     /// Segments before and after (u32::MAX: none).
     pub prev: u32,
     pub next: u32,
@@ -48,7 +53,7 @@ pub(crate) struct BoltNode {
     pub mass: f64,
 }
 
-const NONE: u32 = u32::MAX;
+pub(crate) const NONE: u32 = u32::MAX;
 
 /// Fully grouted rock bolts and cables (manual 7.9): compose after the mechanics (the
 /// grout's confinement reads the host elements' stress of the previous step).
@@ -62,8 +67,8 @@ const NONE: u32 = u32::MAX;
 #[derive(Clone)]
 pub struct Bolts {
     bolts: Vec<Bolt>,
-    segments: Vec<Segment>,
-    nodes: Vec<BoltNode>,
+    pub(crate) segments: Vec<Segment>,
+    pub(crate) nodes: Vec<BoltNode>,
     /// First bolt-node and segment index of each bolt.
     node_offset: Vec<usize>,
     segment_offset: Vec<usize>,
@@ -179,6 +184,7 @@ impl Bolts {
             for s in 0..n - 1 {
                 self.segments.push(Segment {
                     n: [node + s as u32, node + s as u32 + 1],
+                    dx: std::array::from_fn(|k| pts[s + 1][k] - pts[s][k]),
                     l0: bolt.segment_length(s),
                     law: eff.axial,
                     damping: eff.damping,
@@ -217,6 +223,7 @@ impl Bolts {
                     k_axial: if grouted { eff.shear * l } else { 0.0 },
                     k_normal: eff.normal * l,
                     bond_length: l * eff.bond_per_spacing,
+                    bond: bolt.material().bond_constants(),
                     prev: if k > 0 { seg0 + k as u32 - 1 } else { NONE },
                     next: if k + 1 < n { seg0 + k as u32 } else { NONE },
                     plate: if k == 0 {
@@ -288,6 +295,40 @@ fn rotation_2d(xr: &[f64], xc: &[f64]) -> [f64; 2] {
     } else {
         [1.0, 0.0]
     }
+}
+
+/// Displacement of node `n` (m; z = 0 in 2D).
+fn disp<D: Dim>(kin: &Kinematics<'_, D>, n: u32) -> [f64; 3] {
+    let d = D::D;
+    let mut u = [0.0; 3];
+    u[..d].copy_from_slice(&kin.u[n as usize * d..n as usize * d + d]);
+    u
+}
+
+/// A segment's current unit direction and elongation L − L₀ (m), the latter as
+/// (2 ΔX·Δu + Δu·Δu) / (L + L₀) from the displacements, so that it keeps its digits
+/// where L − L₀ from positions would cancel (a stiff bar's force would carry E A / L₀
+/// times a rounding of the coordinates).
+fn segment_state<D: Dim>(seg: &Segment, kin: &Kinematics<'_, D>) -> ([f64; 3], f64) {
+    let (u0, u1) = (disp(kin, seg.n[0]), disp(kin, seg.n[1]));
+    let du = [u1[0] - u0[0], u1[1] - u0[1], u1[2] - u0[2]];
+    let x = &seg.dx;
+    let dv = [x[0] + du[0], x[1] + du[1], x[2] + du[2]];
+    let (e, l) = unit(dv);
+    let q = 2.0 * (x[0] * du[0] + x[1] * du[1] + x[2] * du[2])
+        + (du[0] * du[0] + du[1] * du[1] + du[2] * du[2]);
+    (e, q / (l + seg.l0))
+}
+
+/// Displacement of bolt node `n` relative to its host's material point,
+/// u_n − Σ_q w_q u_q (m): zero under any rigid motion, since the node sat at that point.
+fn relative_disp<D: Dim>(n: &BoltNode, kin: &Kinematics<'_, D>) -> [f64; 3] {
+    let mut r = disp(kin, n.node);
+    for q in 0..=D::D {
+        let u = disp(kin, n.host_nodes[q]);
+        (0..3).for_each(|k| r[k] -= n.weights[q] * u[k]);
+    }
+    r
 }
 
 fn unit(v: [f64; 3]) -> ([f64; 3], f64) {
@@ -462,13 +503,9 @@ impl<D: Dim> Physics<D> for Bolts {
             let [axial, plastic, state] =
                 ctx.fields.get_many_mut([ids.axial, ids.plastic, ids.state]);
             for (s, seg) in self.segments.iter().enumerate() {
-                let (x0, x1) = (
-                    kin.position(seg.n[0] as usize),
-                    kin.position(seg.n[1] as usize),
-                );
-                let (e, l) = unit(std::array::from_fn(|k| x1[k] - x0[k]));
+                let (e, elongation) = segment_state(seg, kin);
                 let broken = SegmentState::from_value(state[s]) == SegmentState::Broken;
-                let (f, up, st) = seg.law.update(l - seg.l0, seg.l0, plastic[s], broken);
+                let (f, up, st) = seg.law.update(elongation, seg.l0, plastic[s], broken);
                 axial[s] = f;
                 plastic[s] = up;
                 state[s] = st as i32 as f64;
@@ -489,7 +526,6 @@ impl<D: Dim> Physics<D> for Bolts {
         let mut xr = [0.0; 12];
         let mut xc = [0.0; 12];
         for (i, n) in self.nodes.iter().enumerate() {
-            let material = self.bolts[n.bolt as usize].material();
             // Bar forces on the node: +f e as the start of the next segment, −f e as the
             // end of the previous one (fixed order: previous, next).
             let mut f = [0.0; 3];
@@ -502,28 +538,17 @@ impl<D: Dim> Physics<D> for Bolts {
                 (0..3).for_each(|k| f[k] += g[k]);
             }
             // Axis at the node: mean of the adjacent segments' current directions.
-            let xb = kin.position(n.node as usize);
             let mut axis = [0.0; 3];
-            for (s, sign) in [(n.prev, 1.0), (n.next, 1.0)] {
+            for s in [n.prev, n.next] {
                 if s != NONE {
-                    let seg = &self.segments[s as usize];
-                    let (x0, x1) = (
-                        kin.position(seg.n[0] as usize),
-                        kin.position(seg.n[1] as usize),
-                    );
-                    let (e, _) = unit(std::array::from_fn(|k| x1[k] - x0[k]));
-                    (0..3).for_each(|k| axis[k] += sign * e[k]);
+                    let (e, _) = segment_state(&self.segments[s as usize], kin);
+                    (0..3).for_each(|k| axis[k] += e[k]);
                 }
             }
             let (a, _) = unit(axis);
-            // The host's material point where the node was grouted.
-            let mut xh = [0.0; 3];
-            for q in 0..=d {
-                let p = kin.position(n.host_nodes[q] as usize);
-                (0..d).for_each(|k| xh[k] += n.weights[q] * p[k]);
-            }
-            let r: [f64; 3] = std::array::from_fn(|k| xb[k] - xh[k]);
-            let delta: f64 = (0..3).map(|k| r[k] * a[k]).sum();
+            // Against the host's material point where the node was grouted.
+            let r = relative_disp(n, kin);
+            let delta = r[0] * a[0] + r[1] * a[1] + r[2] * a[2];
             // Grout along the axis: bond-slip with the host's confinement.
             let mut fs = 0.0;
             if n.k_axial > 0.0 {
@@ -540,7 +565,7 @@ impl<D: Dim> Physics<D> for Bolts {
                     rotation.as_ref().expect("3D reads the rotation")[9 * e..9 * e + 9].to_vec()
                 };
                 let sn = confinement(d, &stress[nsym * e..nsym * (e + 1)], &a, &rot);
-                let cap = material.bond_strength(sn) * n.bond_length;
+                let cap = crate::material::bond_strength(&n.bond, sn) * n.bond_length;
                 let (force, s) = crate::material::grout_force(delta, slip[i], n.k_axial, cap);
                 fs = force;
                 slip[i] = s;
@@ -575,19 +600,12 @@ impl<D: Dim> Physics<D> for Bolts {
         for (s, seg) in self.segments.iter().enumerate() {
             e += 0.5 * axial[s] * axial[s] * seg.l0 / seg.law.ea;
         }
-        let d = D::D;
         for (i, n) in self.nodes.iter().enumerate() {
             if n.k_axial > 0.0 {
                 e += 0.5 * grout[i] * grout[i] / n.k_axial;
             }
-            let xb = kin.position(n.node as usize);
-            let mut xh = [0.0; 3];
-            for q in 0..=d {
-                let p = kin.position(n.host_nodes[q] as usize);
-                (0..d).for_each(|k| xh[k] += n.weights[q] * p[k]);
-            }
-            let r2: f64 = (0..d).map(|k| (xb[k] - xh[k]).powi(2)).sum();
-            e += 0.5 * n.k_normal * r2;
+            let r = relative_disp(n, kin);
+            e += 0.5 * n.k_normal * (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
         }
         e
     }
@@ -615,6 +633,13 @@ impl<D: Dim> Physics<D> for Bolts {
         f.finish()
     }
 
+    fn gpu_setup(
+        &mut self,
+        setup: &mut pcdc_compute::gpu::GpuSetup<'_, D>,
+    ) -> Result<(), ComputeError> {
+        crate::gpu::bolts(self, setup)
+    }
+
     fn slot_entity(&self, slot: usize) -> Option<String> {
         // Slots per bolt node: the node, then its host's D + 1 nodes.
         let n = self.nodes.get(slot / (D::D + 2))?;
@@ -631,7 +656,7 @@ pub struct BoltBoundary {
     /// Name, range in the bolt-node set and spacing of every bolt.
     bolts: Vec<(String, std::ops::Range<usize>, f64)>,
     items: Vec<BoltBc>,
-    resolved: Vec<ResolvedBc>,
+    pub(crate) resolved: Vec<ResolvedBc>,
     accel: Option<FieldId>,
 }
 
@@ -782,6 +807,13 @@ impl<D: Dim> Physics<D> for BoltBoundary {
         true
     }
 
+    fn gpu_setup(
+        &mut self,
+        setup: &mut pcdc_compute::gpu::GpuSetup<'_, D>,
+    ) -> Result<(), ComputeError> {
+        crate::gpu::boundary(self, setup)
+    }
+
     fn applies_loads(&self) -> bool {
         true
     }
@@ -799,8 +831,9 @@ impl<D: Dim> Physics<D> for BoltBoundary {
     }
 
     fn apply_kinematics(&mut self, ctx: &mut VelocityContext<'_, D>) {
+        // As the mechanical boundary: velocities at the half step, accelerations at the
+        // start of the step (`ctx.time` is the end of the step).
         let d = D::D;
-        let t = ctx.time;
         for r in &self.resolved {
             match r.kind {
                 BcKind::Force => {}
@@ -808,7 +841,7 @@ impl<D: Dim> Physics<D> for BoltBoundary {
                     for &(n, _) in &r.nodes {
                         for k in 0..d {
                             if let Some(v) = &r.values[k] {
-                                ctx.v[n as usize * d + k] = v.at(t);
+                                ctx.v[n as usize * d + k] = v.at(ctx.time - 0.5 * ctx.dt);
                             }
                         }
                     }
@@ -820,7 +853,7 @@ impl<D: Dim> Physics<D> for BoltBoundary {
                         for k in 0..d {
                             if let Some(v) = &r.values[k] {
                                 let w = &mut acc[b as usize * d + k];
-                                *w += v.at(t) * ctx.dt;
+                                *w += v.at(ctx.time - ctx.dt) * ctx.dt;
                                 ctx.v[n as usize * d + k] = *w;
                             }
                         }
