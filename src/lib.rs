@@ -2,7 +2,7 @@
 //!
 //! Facade of the pcdc-rs SDK for continuum–discontinuum geomechanics by the combined
 //! finite–discrete element method (FDEM): re-exports the crates ([`mesh`], [`compute`],
-//! [`mech`], [`cohesive`], [`contact`], [`hydro`], [`thermal`]) and composes them: [`fdem::Fdem`] is the
+//! [`mech`], [`cohesive`], [`contact`], [`hydro`], [`thermal`], [`bolt`]) and composes them: [`fdem::Fdem`] is the
 //! canonical FDEM composition in one call. The validation scenes, their RESULT lines,
 //! scene files and plots live in the separate crate `pcdc-validation`, so adding `pcdc`
 //! brings the SDK only. The cargo feature `gpu` (on by default) brings the GPU backend.
@@ -37,6 +37,7 @@
 // Index loops mirror the tensor notation of the manual's equations.
 #![allow(clippy::needless_range_loop)]
 
+pub use pcdc_bolt as bolt;
 pub use pcdc_cohesive as cohesive;
 pub use pcdc_compute as compute;
 pub use pcdc_contact as contact;

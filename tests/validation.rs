@@ -3,7 +3,7 @@
 
 use pcdc::compute::Backend;
 use pcdc_validation::scenes::{
-    fracture_flow, half_space_conduction, injection, kirsch, lauwerier, radial_flow,
+    bolt_pullout, fracture_flow, half_space_conduction, injection, kirsch, lauwerier, radial_flow,
     slope_excavation, thermal_cracking, thermal_cylinder, unconfined_flow, vibration_energy,
     wave_speed, Element,
 };
@@ -502,4 +502,35 @@ fn thermal_cracking_starts_at_the_outer_surface_at_ts() {
     let broken: Vec<usize> = o.snapshots.iter().map(|s| s.broken.len()).collect();
     assert!(broken.windows(2).all(|w| w[0] <= w[1]), "{broken:?}");
     assert!(*broken.last().unwrap() > 0, "no joint broke: {broken:?}");
+}
+
+/// Scene 15 at the coarsest segments: the axial force along a grouted bolt pulled from a
+/// rigid block within 3 % of F0 sinh(β(L − x))/sinh(βL); pulled to failure under
+/// confinement, the load peaks at the bond strength times the length (2 %) before the bar
+/// yields and stays there.
+#[test]
+fn bolt_pullout_matches_the_closed_form_and_fails_at_the_bond_strength() {
+    let p = bolt_pullout::Params {
+        size: bolt_pullout::SIZES[0],
+    };
+    let e = bolt_pullout::run_elastic(&cpu(), &p).unwrap();
+    eprintln!(
+        "bolt_pullout: error {:.3e} of F0, {} segments",
+        e.error, e.segments
+    );
+    assert!(e.pass(), "error {}", e.error);
+    let f = bolt_pullout::run_failure(&cpu(), &p).unwrap();
+    eprintln!(
+        "bolt_pullout_failure: peak/SL {:.6}, end/peak {:.6}, F/F_yield {:.3}",
+        f.peak_ratio, f.end_ratio, f.axial_ratio
+    );
+    assert!(
+        f.pass(),
+        "peak {} end {} axial {}",
+        f.peak_ratio,
+        f.end_ratio,
+        f.axial_ratio
+    );
+    // The curve rises to the plateau: the load at the first sample is below the peak.
+    assert!(f.curve[0].1 < 0.9 * f.peak_ratio * bolt_pullout::capacity());
 }

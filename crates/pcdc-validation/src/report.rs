@@ -133,6 +133,9 @@ pub enum SceneError {
     /// Cohesive error.
     #[error(transparent)]
     Cohesive(#[from] pcdc_cohesive::CohesiveError),
+    /// A bolt error.
+    #[error(transparent)]
+    Bolt(#[from] pcdc_bolt::BoltError),
     /// Plot error.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),

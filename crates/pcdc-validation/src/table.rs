@@ -16,9 +16,10 @@ use pcdc_compute::{Backend, BackendKind, Precision};
 use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
-    block_sliding, brazilian, creep, direct_tension, fracture_flow, half_space_conduction,
-    injection, kirsch, lauwerier, radial_flow, slope_excavation, thermal_cracking,
-    thermal_cylinder, triaxial, tunnel, ucs, unconfined_flow, vibration_energy, wave_speed,
+    block_sliding, bolt_pullout, brazilian, creep, direct_tension, fracture_flow,
+    half_space_conduction, injection, kirsch, lauwerier, radial_flow, slope_excavation,
+    thermal_cracking, thermal_cylinder, triaxial, tunnel, ucs, unconfined_flow, vibration_energy,
+    wave_speed,
 };
 
 /// One measured row of the report.
@@ -134,6 +135,8 @@ pub const CASES: &[&str] = &[
     "thermal_cylinder",
     "lauwerier",
     "thermal_cracking",
+    "bolt_pullout",
+    "bolt_pullout_failure",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -302,6 +305,17 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("thermal_cracking", "onset", size));
             }
         }
+        // The size is the bolt's segment length; the host is rigid.
+        "bolt_pullout" => {
+            for size in bolt_pullout::SIZES {
+                out.push(j("bolt_pullout", "elastic", size));
+            }
+        }
+        "bolt_pullout_failure" => {
+            for size in bolt_pullout::SIZES {
+                out.push(j("bolt_pullout_failure", "peak", size));
+            }
+        }
         // Homogeneous blocks: the mesh changes the cost, not the closed form.
         "creep" => {
             for size in [0.05, 0.025, 0.0125] {
@@ -456,6 +470,24 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
         "lauwerier" => {
             let o = lauwerier::run(backend, &lauwerier::Params { size: job.size })?;
             within(o.elements, o.error, lauwerier::TOL, o.steps)
+        }
+        "bolt_pullout" => {
+            let o = bolt_pullout::run_elastic(backend, &bolt_pullout::Params { size: job.size })?;
+            within(o.segments, o.error, bolt_pullout::TOL, o.steps)
+        }
+        "bolt_pullout_failure" => {
+            let o = bolt_pullout::run_failure(backend, &bolt_pullout::Params { size: job.size })?;
+            row(
+                o.segments,
+                o.error,
+                format!(
+                    "{} % (bar at {:.2} of its yield force)",
+                    bolt_pullout::TOL_PEAK * 100.0,
+                    o.axial_ratio
+                ),
+                o.pass(),
+                o.steps,
+            )
         }
         "thermal_cracking" => {
             let o = thermal_cracking::run(backend, &thermal_cracking::Params::new(job.size))?;
@@ -695,7 +727,11 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
          T_i − T_o) in the tolerance column; lauwerier: largest |T − T_exact| / (T_a − T_i) of \
          the fluid along the fracture and the rock 5 m from it at 50 and 150 days; \
          thermal_cracking: |σn / Ts − 1| with σn the closed-form normal traction on the \
-         first joint to soften, from the computed temperature field). Wall time includes the build; \
+         first joint to soften, from the computed temperature field; bolt_pullout: largest \
+         |F − F_exact| / F0 of the axial force along the bolt, its size column the segment \
+         length and its elements column counting bolt segments; bolt_pullout_failure: the \
+         larger of |peak / (S_b L) − 1| and the load's drop from the peak at the end of the \
+         pull, same columns). Wall time includes the build; \
          element-steps/s = elements × steps / wall time (the direct Kirsch solve counts \
          its iterations as steps). GPU rows on a software adapter (Mesa's lavapipe) \
          show that the path works and what it costs there, not GPU speed.\n\n",

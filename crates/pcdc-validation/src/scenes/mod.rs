@@ -11,6 +11,7 @@
 
 pub mod benchmark;
 pub mod block_sliding;
+pub mod bolt_pullout;
 pub mod brazilian;
 pub mod creep;
 pub mod direct_tension;
