@@ -7,6 +7,7 @@ use pcdc_compute::{
     ForceContext, InitContext, KinematicNodes, Kinematics, Physics, StableStep, VelocityContext,
 };
 use pcdc_mesh::{Dim, Mesh};
+use rayon::prelude::*;
 
 use crate::boundary::{BcKind, BoltBc, BoltNodes, ResolvedBc};
 use crate::fields::*;
@@ -73,8 +74,9 @@ pub struct Bolts {
     node_offset: Vec<usize>,
     segment_offset: Vec<usize>,
     ids: Option<Ids>,
-    /// Work buffer: segment force vectors (stride 3).
+    /// Work buffers: segment force vectors and current unit directions.
     seg_force: Vec<[f64; 3]>,
+    seg_dir: Vec<[f64; 3]>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -105,6 +107,7 @@ impl Bolts {
             segment_offset: Vec::new(),
             ids: None,
             seg_force: Vec::new(),
+            seg_dir: Vec::new(),
         }
     }
 
@@ -340,6 +343,97 @@ fn unit(v: [f64; 3]) -> ([f64; 3], f64) {
     }
 }
 
+/// Rayon blocks of at least this many segments or nodes (an item is cheap).
+const MIN_LEN: usize = 256;
+
+/// What the node pass reads: the segments and their forces, the host stresses (and
+/// rotations in 3D).
+struct NodePass<'a> {
+    seg_dir: &'a [[f64; 3]],
+    seg_force: &'a [[f64; 3]],
+    stress: &'a [f64],
+    rotation: &'a [f64],
+}
+
+impl NodePass<'_> {
+    /// One bolt node: its bar forces (previous then next segment), the grout against its
+    /// host with the host's confinement, the lateral grout and the face plate; writes its
+    /// slot and its host's `D + 1` slots (`slots`), its grout force and slip.
+    fn node<D: Dim>(
+        &self,
+        n: &BoltNode,
+        kin: &Kinematics<'_, D>,
+        slots: &mut [f64],
+        grout: &mut f64,
+        slip: &mut f64,
+    ) {
+        let d = D::D;
+        // Bar forces on the node: +f e as the start of the next segment, −f e as the
+        // end of the previous one (fixed order: previous, next).
+        let mut f = [0.0; 3];
+        if n.prev != NONE {
+            let g = self.seg_force[n.prev as usize];
+            (0..3).for_each(|k| f[k] -= g[k]);
+        }
+        if n.next != NONE {
+            let g = self.seg_force[n.next as usize];
+            (0..3).for_each(|k| f[k] += g[k]);
+        }
+        // Axis at the node: mean of the adjacent segments' current directions.
+        let mut axis = [0.0; 3];
+        for s in [n.prev, n.next] {
+            if s != NONE {
+                let e = self.seg_dir[s as usize];
+                (0..3).for_each(|k| axis[k] += e[k]);
+            }
+        }
+        let (a, _) = unit(axis);
+        // Against the host's material point where the node was grouted.
+        let r = relative_disp(n, kin);
+        let delta = r[0] * a[0] + r[1] * a[1] + r[2] * a[2];
+        // Grout along the axis: bond-slip with the host's confinement.
+        let mut fs = 0.0;
+        if n.k_axial > 0.0 {
+            let e = n.host as usize;
+            let mut rot = [0.0; 9];
+            if d == 2 {
+                let (mut xr, mut xc) = ([0.0; 6], [0.0; 6]);
+                for q in 0..3 {
+                    let node = n.host_nodes[q] as usize;
+                    xr[2 * q..2 * q + 2].copy_from_slice(&kin.coords[2 * node..2 * node + 2]);
+                    let p = kin.position(node);
+                    xc[2 * q..2 * q + 2].copy_from_slice(&p[..2]);
+                }
+                rot[..2].copy_from_slice(&rotation_2d(&xr, &xc));
+            } else {
+                rot.copy_from_slice(&self.rotation[9 * e..9 * e + 9]);
+            }
+            let nsym = D::NSYM;
+            let sn = confinement(d, &self.stress[nsym * e..nsym * (e + 1)], &a, &rot);
+            let cap = crate::material::bond_strength(&n.bond, sn) * n.bond_length;
+            let (force, s) = crate::material::grout_force(delta, *slip, n.k_axial, cap);
+            fs = force;
+            *slip = s;
+        }
+        *grout = fs;
+        // Lateral grout, and the face plate (one-sided, pushes the head back out).
+        let mut g: [f64; 3] =
+            std::array::from_fn(|k| fs * a[k] + n.k_normal * (r[k] - delta * a[k]));
+        if n.plate > 0.0 && delta > 0.0 {
+            (0..3).for_each(|k| g[k] += n.plate * delta * a[k]);
+        }
+        for k in 0..d {
+            slots[k] = f[k] - g[k];
+        }
+        for q in 0..=d {
+            let o = (q + 1) * d;
+            for (k, gk) in g.iter().enumerate().take(d) {
+                slots[o + k] = n.weights[q] * gk;
+            }
+        }
+    }
+}
+
 impl<D: Dim> Physics<D> for Bolts {
     fn name(&self) -> &str {
         NAME
@@ -433,6 +527,7 @@ impl<D: Dim> Physics<D> for Bolts {
         ctx.fields.get_mut(ids.plastic).copy_from_slice(&plastic);
         self.ids = Some(ids);
         self.seg_force = vec![[0.0; 3]; self.segments.len()];
+        self.seg_dir = vec![[0.0; 3]; self.segments.len()];
         Ok(())
     }
 
@@ -494,100 +589,70 @@ impl<D: Dim> Physics<D> for Bolts {
         true
     }
 
+    fn kinematic_nodes(&self) -> KinematicNodes {
+        // No kinematic conditions here (they are `BoltBoundary`'s): the engine keeps its
+        // fused node pass.
+        KinematicNodes::None
+    }
+
     fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let d = D::D;
         let ids = self.ids.expect("init ran");
         let kin = &ctx.kin;
-        // Segments: axial force (total form) plus damping on the relative velocity.
+        // Segments: axial force (total form) plus damping on the relative velocity. Each
+        // segment and each node writes only its own entries: parallel and deterministic.
         {
             let [axial, plastic, state] =
                 ctx.fields.get_many_mut([ids.axial, ids.plastic, ids.state]);
-            for (s, seg) in self.segments.iter().enumerate() {
-                let (e, elongation) = segment_state(seg, kin);
-                let broken = SegmentState::from_value(state[s]) == SegmentState::Broken;
-                let (f, up, st) = seg.law.update(elongation, seg.l0, plastic[s], broken);
-                axial[s] = f;
-                plastic[s] = up;
-                state[s] = st as i32 as f64;
-                let mut total = f;
-                if seg.damping > 0.0 && st != SegmentState::Broken {
-                    let (a, b) = (seg.n[0] as usize * d, seg.n[1] as usize * d);
-                    let rel: f64 = (0..d).map(|k| (kin.v[b + k] - kin.v[a + k]) * e[k]).sum();
-                    total += seg.damping * rel;
-                }
-                self.seg_force[s] = [total * e[0], total * e[1], total * e[2]];
-            }
-        }
-        let stress = ctx.fields.get(ids.stress).to_vec();
-        let rotation = ids.rotation.map(|r| ctx.fields.get(r).to_vec());
-        let [grout, slip] = ctx.fields.get_many_mut([ids.grout, ids.slip]);
-        let nsym = D::NSYM;
-        let stride = d + 2;
-        let mut xr = [0.0; 12];
-        let mut xc = [0.0; 12];
-        for (i, n) in self.nodes.iter().enumerate() {
-            // Bar forces on the node: +f e as the start of the next segment, −f e as the
-            // end of the previous one (fixed order: previous, next).
-            let mut f = [0.0; 3];
-            if n.prev != NONE {
-                let g = self.seg_force[n.prev as usize];
-                (0..3).for_each(|k| f[k] -= g[k]);
-            }
-            if n.next != NONE {
-                let g = self.seg_force[n.next as usize];
-                (0..3).for_each(|k| f[k] += g[k]);
-            }
-            // Axis at the node: mean of the adjacent segments' current directions.
-            let mut axis = [0.0; 3];
-            for s in [n.prev, n.next] {
-                if s != NONE {
-                    let (e, _) = segment_state(&self.segments[s as usize], kin);
-                    (0..3).for_each(|k| axis[k] += e[k]);
-                }
-            }
-            let (a, _) = unit(axis);
-            // Against the host's material point where the node was grouted.
-            let r = relative_disp(n, kin);
-            let delta = r[0] * a[0] + r[1] * a[1] + r[2] * a[2];
-            // Grout along the axis: bond-slip with the host's confinement.
-            let mut fs = 0.0;
-            if n.k_axial > 0.0 {
-                let e = n.host as usize;
-                let rot = if d == 2 {
-                    for q in 0..3 {
-                        let node = n.host_nodes[q] as usize;
-                        xr[2 * q..2 * q + 2].copy_from_slice(&kin.coords[2 * node..2 * node + 2]);
-                        let p = kin.position(node);
-                        xc[2 * q..2 * q + 2].copy_from_slice(&p[..2]);
+            self.segments
+                .par_iter()
+                .zip(
+                    self.seg_force
+                        .par_iter_mut()
+                        .zip(self.seg_dir.par_iter_mut()),
+                )
+                .zip(axial.par_iter_mut())
+                .zip(plastic.par_iter_mut().zip(state.par_iter_mut()))
+                .with_min_len(MIN_LEN)
+                .for_each(|(((seg, (force, dir)), axial), (plastic, state))| {
+                    let (e, elongation) = segment_state(seg, kin);
+                    *dir = e;
+                    let broken = SegmentState::from_value(*state) == SegmentState::Broken;
+                    let (f, up, st) = seg.law.update(elongation, seg.l0, *plastic, broken);
+                    *axial = f;
+                    *plastic = up;
+                    *state = st as i32 as f64;
+                    let mut total = f;
+                    if seg.damping > 0.0 && st != SegmentState::Broken {
+                        let (a, b) = (seg.n[0] as usize * d, seg.n[1] as usize * d);
+                        let rel: f64 = (0..d).map(|k| (kin.v[b + k] - kin.v[a + k]) * e[k]).sum();
+                        total += seg.damping * rel;
                     }
-                    rotation_2d(&xr[..6], &xc[..6]).to_vec()
-                } else {
-                    rotation.as_ref().expect("3D reads the rotation")[9 * e..9 * e + 9].to_vec()
-                };
-                let sn = confinement(d, &stress[nsym * e..nsym * (e + 1)], &a, &rot);
-                let cap = crate::material::bond_strength(&n.bond, sn) * n.bond_length;
-                let (force, s) = crate::material::grout_force(delta, slip[i], n.k_axial, cap);
-                fs = force;
-                slip[i] = s;
-            }
-            grout[i] = fs;
-            // Lateral grout, and the face plate (one-sided, pushes the head back out).
-            let mut g: [f64; 3] =
-                std::array::from_fn(|k| fs * a[k] + n.k_normal * (r[k] - delta * a[k]));
-            if n.plate > 0.0 && delta > 0.0 {
-                (0..3).for_each(|k| g[k] += n.plate * delta * a[k]);
-            }
-            let base = i * stride * d;
-            for k in 0..d {
-                ctx.slots[base + k] = f[k] - g[k];
-            }
-            for q in 0..=d {
-                let o = base + (q + 1) * d;
-                for (k, gk) in g.iter().enumerate().take(d) {
-                    ctx.slots[o + k] = n.weights[q] * gk;
-                }
-            }
+                    *force = [total * e[0], total * e[1], total * e[2]];
+                });
         }
+        // Nodes: the host's stress (and rotation in 3D) are read in place.
+        let (grout, slip, stress, rotation) = if let Some(r) = ids.rotation {
+            let [g, s, st, rot] = ctx
+                .fields
+                .get_many_mut([ids.grout, ids.slip, ids.stress, r]);
+            (g, s, &*st, &*rot)
+        } else {
+            let [g, s, st] = ctx.fields.get_many_mut([ids.grout, ids.slip, ids.stress]);
+            (g, s, &*st, &[][..])
+        };
+        let pass = NodePass {
+            seg_dir: &self.seg_dir,
+            seg_force: &self.seg_force,
+            stress,
+            rotation,
+        };
+        ctx.slots
+            .par_chunks_mut((d + 2) * d)
+            .zip(self.nodes.par_iter())
+            .zip(grout.par_iter_mut().zip(slip.par_iter_mut()))
+            .with_min_len(MIN_LEN)
+            .for_each(|((slots, n), (grout, slip))| pass.node(n, kin, slots, grout, slip));
         Ok(())
     }
 
