@@ -3,9 +3,9 @@
 
 use pcdc::compute::Backend;
 use pcdc_validation::scenes::{
-    bolt_pullout, fracture_flow, half_space_conduction, injection, kirsch, lauwerier, radial_flow,
-    slope_excavation, thermal_cracking, thermal_cylinder, unconfined_flow, vibration_energy,
-    wave_speed, Element,
+    bolt_pullout, bolted_shear, fracture_flow, half_space_conduction, injection, kirsch, lauwerier,
+    radial_flow, slope_excavation, thermal_cracking, thermal_cylinder, unconfined_flow,
+    vibration_energy, wave_speed, Element,
 };
 
 fn cpu() -> Backend {
@@ -533,4 +533,27 @@ fn bolt_pullout_matches_the_closed_form_and_fails_at_the_bond_strength() {
     );
     // The curve rises to the plateau: the load at the first sample is below the peak.
     assert!(f.curve[0].1 < 0.9 * f.peak_ratio * bolt_pullout::capacity());
+}
+
+/// The bolted direct shear test at the coarsest size: the shear force of the sliding
+/// joint plus the inclined bolt's axial force within 5 % of the bolt's share of the
+/// closed form, and the bolt yields in tension as the joint slides.
+#[test]
+fn bolted_shear_adds_the_bolt_force_to_the_joint_friction() {
+    let o = bolted_shear::run(
+        &cpu(),
+        &bolted_shear::Params {
+            size: bolted_shear::SIZES[0],
+        },
+    )
+    .unwrap();
+    let end = o.samples.last().unwrap();
+    eprintln!(
+        "bolted_shear: error {:.3e}, yielded {}, T {:.1} kN, P {:.1} kN",
+        o.error,
+        o.yielded,
+        end.force / 1e3,
+        end.bolt_force / 1e3
+    );
+    assert!(o.pass(), "error {} yielded {}", o.error, o.yielded);
 }

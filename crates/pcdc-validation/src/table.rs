@@ -16,7 +16,7 @@ use pcdc_compute::{Backend, BackendKind, Precision};
 use crate::plot::Plot;
 use crate::report::SceneError;
 use crate::scenes::{
-    block_sliding, bolt_pullout, brazilian, creep, direct_tension, fracture_flow,
+    block_sliding, bolt_pullout, bolted_shear, brazilian, creep, direct_tension, fracture_flow,
     half_space_conduction, injection, kirsch, lauwerier, radial_flow, slope_excavation,
     thermal_cracking, thermal_cylinder, triaxial, tunnel, ucs, unconfined_flow, vibration_energy,
     wave_speed,
@@ -137,6 +137,7 @@ pub const CASES: &[&str] = &[
     "thermal_cracking",
     "bolt_pullout",
     "bolt_pullout_failure",
+    "bolted_shear",
 ];
 
 /// A measurement the report will make: case, variant, mesh size.
@@ -316,6 +317,11 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
                 out.push(j("bolt_pullout_failure", "peak", size));
             }
         }
+        "bolted_shear" => {
+            for size in bolted_shear::SIZES {
+                out.push(j("bolted_shear", "dowel", size));
+            }
+        }
         // Homogeneous blocks: the mesh changes the cost, not the closed form.
         "creep" => {
             for size in [0.05, 0.025, 0.0125] {
@@ -470,6 +476,24 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
         "lauwerier" => {
             let o = lauwerier::run(backend, &lauwerier::Params { size: job.size })?;
             within(o.elements, o.error, lauwerier::TOL, o.steps)
+        }
+        "bolted_shear" => {
+            let o = bolted_shear::run(backend, &bolted_shear::Params { size: job.size })?;
+            row(
+                o.elements,
+                o.error,
+                format!(
+                    "{} % (bolt {})",
+                    bolted_shear::TOL * 100.0,
+                    if o.yielded {
+                        "yielded"
+                    } else {
+                        "did not yield"
+                    }
+                ),
+                o.pass(),
+                o.steps,
+            )
         }
         "bolt_pullout" => {
             let o = bolt_pullout::run_elastic(backend, &bolt_pullout::Params { size: job.size })?;
@@ -731,7 +755,8 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
          |F − F_exact| / F0 of the axial force along the bolt, its size column the segment \
          length and its elements column counting bolt segments; bolt_pullout_failure: the \
          larger of |peak / (S_b L) − 1| and the load's drop from the peak at the end of the \
-         pull, same columns). Wall time includes the build; \
+         pull, same columns; bolted_shear: largest |T̄ − T̄_exact| of 0.5 mm window means \
+         over the bolt's share T̄_exact − σn A tan φ). Wall time includes the build; \
          element-steps/s = elements × steps / wall time (the direct Kirsch solve counts \
          its iterations as steps). GPU rows on a software adapter (Mesa's lavapipe) \
          show that the path works and what it costs there, not GPU speed.\n\n",

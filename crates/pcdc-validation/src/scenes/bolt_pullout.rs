@@ -10,7 +10,7 @@
 //! F(x) = F0 sinh(β (L − x)) / sinh(β L), β = √(K / (E_b A_b)) (βL = 3.19 here).
 //!
 //! Compared at every segment's midpoint after static relaxation (unbalanced-force ratio
-//! 10⁻⁹); error = the largest |F − F_exact| / F0, tolerance 3 %. The bond is far from
+//! 10⁻⁹; 10⁻⁵ in f32); error = the largest |F − F_exact| / F0, tolerance 3 %. The bond is far from
 //! its strength (peak grout shear β F0 coth(βL) = 48 kN/m against 71 kN/m: no slip).
 //!
 //! **Pull-out to failure.** The same rebar, L = 1 m, in a block under an isotropic
@@ -181,8 +181,14 @@ pub fn run_elastic(backend: &Backend, p: &Params) -> Result<Elastic, SceneError>
         .physics(bolts)
         .physics(pull)
         .build()?;
+    // f32 cannot balance forces below about 1e-5 of their gross sum.
+    let tolerance = if backend.precision_kind() == pcdc_compute::Precision::F32 {
+        1e-5
+    } else {
+        1e-9
+    };
     let report = sim.relax(&StaticOptions {
-        tolerance: 1e-9,
+        tolerance,
         max_steps: 2_000_000,
         ..StaticOptions::default()
     })?;

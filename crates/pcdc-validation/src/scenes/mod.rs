@@ -12,6 +12,7 @@
 pub mod benchmark;
 pub mod block_sliding;
 pub mod bolt_pullout;
+pub mod bolted_shear;
 pub mod brazilian;
 pub mod creep;
 pub mod direct_tension;
