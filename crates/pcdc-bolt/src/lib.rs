@@ -79,7 +79,8 @@
 //! Fields (on the entity sets [`BOLT_SEGMENTS`] and [`BOLT_NODES`]): [`BOLT_AXIAL_FORCE`],
 //! [`BOLT_PLASTIC_ELONGATION`], [`BOLT_STATE`], [`BOLT_GROUT_FORCE`], [`BOLT_SLIP`].
 //! Output: [`output::BoltSeries`] writes the bolts as VTU line cells for ParaView,
-//! [`output::axial_force_profile`] gives the force along a bolt for CSV histories.
+//! [`output::axial_force_profile`] gives the force along a bolt and
+//! [`output::AxialForceCsv`] writes its CSV history.
 //!
 //! On the GPU the bolts run as two force-phase kernels (segments, then nodes: each node
 //! gathers its two segments in a fixed order and writes its own and its host's slots),

@@ -119,3 +119,58 @@ pub fn axial_force_profile<D: Dim>(
         .map(|(i, s)| (bolt.arc_length(i) + 0.5 * bolt.segment_length(i), f[s]))
         .collect())
 }
+
+/// A CSV history of the axial force along one bolt: a header with every segment's
+/// distance from the head (m), then one row per call of [`AxialForceCsv::record`]: the
+/// time (s) and every segment's axial force (N; per unit thickness in 2D).
+pub struct AxialForceCsv {
+    file: std::io::BufWriter<std::fs::File>,
+    path: std::path::PathBuf,
+    bolt: usize,
+}
+
+impl AxialForceCsv {
+    /// Creates `path` for bolt `b` of `bolts` (as composed in `sim`) and writes the header.
+    pub fn new<D: Dim>(
+        path: impl AsRef<Path>,
+        sim: &Simulation<D>,
+        bolts: &crate::Bolts,
+        b: usize,
+    ) -> Result<Self, ComputeError> {
+        use std::io::Write;
+        let path = path.as_ref().to_path_buf();
+        let io = |e: std::io::Error| ComputeError::Io {
+            path: path.display().to_string(),
+            source: e,
+        };
+        let profile = axial_force_profile(sim, bolts, b)?;
+        let mut file = std::io::BufWriter::new(std::fs::File::create(&path).map_err(io)?);
+        let header: Vec<String> = profile
+            .iter()
+            .map(|(x, _)| format!("F_at_{x:.6}_m"))
+            .collect();
+        writeln!(file, "time_s,{}", header.join(",")).map_err(io)?;
+        Ok(AxialForceCsv {
+            file,
+            path,
+            bolt: b,
+        })
+    }
+
+    /// Appends the current time and axial forces.
+    pub fn record<D: Dim>(
+        &mut self,
+        sim: &Simulation<D>,
+        bolts: &crate::Bolts,
+    ) -> Result<(), ComputeError> {
+        use std::io::Write;
+        let io = |e: std::io::Error| ComputeError::Io {
+            path: self.path.display().to_string(),
+            source: e,
+        };
+        let profile = axial_force_profile(sim, bolts, self.bolt)?;
+        let row: Vec<String> = profile.iter().map(|(_, f)| format!("{f:e}")).collect();
+        writeln!(self.file, "{:e},{}", sim.kinematics().time, row.join(",")).map_err(io)?;
+        self.file.flush().map_err(io)
+    }
+}
