@@ -19,10 +19,10 @@
 //!   f*_a = (E_b A_b / L_b,i)(L − L_b,i − u_p) with the plastic elongation u_p, which is
 //!   the same law summed exactly and does not drift when the segment rotates;
 //! * f_a = min(f*_a, f_b,t,l) in tension (140), f_a = max(f*_a, −f_b,c,l) in compression
-//!   (141, [CORRECTED]: the manual prints the tensile yield force in this branch);
+//!   (141, \[CORRECTED\]: the manual prints the tensile yield force in this branch);
 //!   the plastic elongation moves so that the force stays on the limit;
 //! * the segment breaks when (L − L_b,i)/L_b,i ≥ ε_b,t,l (142) and carries nothing from
-//!   then on ([NOT IN MANUAL]: permanently).
+//!   then on (\[NOT IN MANUAL\]: permanently).
 //!
 //! Grout at bolt node n with tributary length l_n = (L_b0 + L_b1)/2 (eq. 143-147):
 //!
@@ -34,7 +34,7 @@
 //!   S_r,g = π (D_b + 2 T_g)(C_r,g + σ_n tan φ_r,g) (146), S_b,g = π D_b (C_b,g + σ_n
 //!   tan φ_b,g) (147); σ_n is the host's confining stress across the bolt, the mean
 //!   compressive normal stress over the directions perpendicular to the axis (tension
-//!   gives 0) [NOT IN MANUAL: the manual says "normal stress perpendicular to the
+//!   gives 0) \[NOT IN MANUAL: the manual says "normal stress perpendicular to the
 //!   bolt"]; it is read from the previous step's stress;
 //! * across the axis the grout is an elastic spring k_n l_n per node [NOT IN MANUAL:
 //!   the manual ignores it, which leaves the bolt nodes free to drift sideways; FLAC's
@@ -42,20 +42,20 @@
 //!   `BoltProperties::normal_stiffness`, default K_b,r,s].
 //!
 //! Damping (eq. 148): F = D_b,f C (v_j − v_i)·e on each segment, C = 2 A_b √(E_b ρ_b)
-//! ([CORRECTED]: printed 2 L_b √(E_b ρ_b), which is not a damping coefficient in N·s/m;
+//! (\[CORRECTED\]: printed 2 L_b √(E_b ρ_b), which is not a damping coefficient in N·s/m;
 //! applied to the relative axial velocity of the segment's ends, not to the node's
 //! velocity, so that a bolt in a fragment in free flight is not braked).
 //!
-//! Face plate ([NOT IN MANUAL]): a one-sided spring at the head that pushes the head
+//! Face plate (\[NOT IN MANUAL\]): a one-sided spring at the head that pushes the head
 //! back out when the bolt pulls it into the rock, with the reaction into the rock.
-//! Pretension ([NOT IN MANUAL]): the segments of the free length start with u_p =
+//! Pretension (\[NOT IN MANUAL\]): the segments of the free length start with u_p =
 //! −f_pre L_b,i / (E_b A_b), i.e. shortened so that they carry f_pre when the rock has
 //! not moved; with a face plate the head bears on the rock. 2D spacing ([NOT IN
 //! MANUAL]): a bolt in a 2D (plane-strain) model stands for a row `spacing` apart: its
 //! stiffnesses, strengths, masses, pretension, plate and node forces are divided by the
 //! spacing (per unit thickness), as FLAC smears cables.
 //!
-//! Stable step ([NOT IN MANUAL]): per bolt node, Gershgorin's bound with the hosts held
+//! Stable step (\[NOT IN MANUAL\]): per bolt node, Gershgorin's bound with the hosts held
 //! fixed, ω² ≤ (Σ 2 E_b A_b / L_b,i + max(K_b,r,s, k_n) l_n + k_plate) / m_n, reduced
 //! by √(1 + ζ²) − ζ for the axial damping; it enters the simulation's step like every
 //! other physics' limit and names the limiting bolt node.

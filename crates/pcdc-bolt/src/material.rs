@@ -12,7 +12,7 @@ use crate::BoltError;
 ///
 /// In 2D (plane strain) a bolt stands for a row of bolts `spacing` apart out of plane:
 /// its stiffnesses, strengths, masses and pretension are divided by the spacing (per
-/// unit thickness, as FLAC's cables are smeared) [NOT IN MANUAL].
+/// unit thickness, as FLAC's cables are smeared) \[NOT IN MANUAL\].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoltProperties {
@@ -32,7 +32,7 @@ pub struct BoltProperties {
     /// Grout shear stiffness per unit length K_b,r,s (N/m/m, eq. 143).
     pub shear_stiffness: f64,
     /// Grout stiffness perpendicular to the bolt per unit length (N/m/m)
-    /// [NOT IN MANUAL: the manual ignores it, which leaves the bolt nodes free to drift
+    /// \[NOT IN MANUAL: the manual ignores it, which leaves the bolt nodes free to drift
     /// sideways; FLAC's cable links are rigid across the axis, this is their explicit
     /// penalty form]. `None`: equal to `shear_stiffness`.
     #[serde(default)]
@@ -325,11 +325,11 @@ impl AxialLaw {
     /// the plastic elongation `plastic` accumulated so far (m; negative for a
     /// pretensioned segment, whose natural length is shorter), the trial force
     /// f* = (E_b A_b / L₀)(L − L₀ − u_p) is clamped to [−f_c, f_t] (eq. 140-141,
-    /// [CORRECTED] 141 uses the compressive yield force f_b,c,l, printed f_b,t,l) and
+    /// \[CORRECTED\] 141 uses the compressive yield force f_b,c,l, printed f_b,t,l) and
     /// the plastic elongation moved so that the force stays on the limit. This is eq.
     /// 138-139's increment f + (E_b A_b / L₀) Δu_a summed exactly, so it does not drift
     /// under rotation. A segment whose strain (L − L₀)/L₀ reaches the failure strain
-    /// breaks (eq. 142) and carries nothing from then on [NOT IN MANUAL: permanently].
+    /// breaks (eq. 142) and carries nothing from then on \[NOT IN MANUAL: permanently\].
     ///
     /// Returns (force N, new plastic elongation m, state).
     pub fn update(
