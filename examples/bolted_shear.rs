@@ -42,7 +42,7 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
     );
     let mut last = None;
     for size in bs::SIZES {
-        let out = bs::run(backend, &Params { size })?;
+        let out = bs::run(backend, &Params::new(size))?;
         let end = out.samples.last().copied().expect("samples");
         println!(
             "{:>8.4} {:>9} {:>10.3e} {:>8} {:>10.2} {:>10.2} {:>8} {:>8.2}",

@@ -478,7 +478,7 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
             within(o.elements, o.error, lauwerier::TOL, o.steps)
         }
         "bolted_shear" => {
-            let o = bolted_shear::run(backend, &bolted_shear::Params { size: job.size })?;
+            let o = bolted_shear::run(backend, &bolted_shear::Params::new(job.size))?;
             row(
                 o.elements,
                 o.error,

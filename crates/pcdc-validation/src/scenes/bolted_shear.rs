@@ -88,6 +88,15 @@ pub fn bolt_props() -> BoltProperties {
 pub struct Params {
     /// Element size (m).
     pub size: f64,
+    /// Shear displacement at the end (m), [`SHEAR`] in the example and the report.
+    pub shear: f64,
+}
+
+impl Params {
+    /// Elements of `size` (m), sheared to [`SHEAR`].
+    pub fn new(size: f64) -> Self {
+        Params { size, shear: SHEAR }
+    }
 }
 
 /// One sample of the test.
@@ -130,6 +139,12 @@ impl Outcome {
 /// Runs the test with elements of `p.size` on `backend`.
 pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     let start = Instant::now();
+    if !(p.shear > FROM && p.shear.is_finite()) {
+        return Err(SceneError::Measurement(format!(
+            "shear {} m must exceed the {FROM} m where the comparison starts",
+            p.shear
+        )));
+    }
     if !(p.size > 0.0 && p.size <= HALF_HEIGHT) {
         return Err(SceneError::Measurement(format!(
             "element size {} m must lie in (0, {HALF_HEIGHT}] m",
@@ -219,7 +234,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
         segments[2 * crossing + 1] as usize,
     );
     let tan = FRICTION.to_radians().tan();
-    let t_end = SHEAR / VELOCITY;
+    let t_end = p.shear / VELOCITY;
     let n_samples = 1000;
     let mut samples = Vec::with_capacity(n_samples);
     let mut error: f64 = 0.0;
@@ -248,7 +263,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
     // [`WINDOW`] of shear from [`FROM`] on.
     let base = SIGMA_N * LENGTH * tan;
     let mut from = FROM;
-    while from + WINDOW <= SHEAR * (1.0 + 1e-9) {
+    while from + WINDOW <= p.shear * (1.0 + 1e-9) {
         let w: Vec<&Sample> = samples
             .iter()
             .filter(|s| s.shear >= from && s.shear < from + WINDOW)

@@ -31,6 +31,7 @@ pub mod thermal_cracking;
 pub mod thermal_cylinder;
 pub mod triaxial;
 pub mod tunnel;
+pub mod tunnel_bolts;
 pub mod ucs;
 pub mod unconfined_flow;
 pub mod vibration_energy;
