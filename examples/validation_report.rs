@@ -10,7 +10,8 @@
 //! - `--cases kirsch,wave_speed,...` only these scenes (default: all);
 //! - `--backends cpu,gpu-f64,gpu-f32` only these backends (default: all available);
 //! - `--resume` keep the rows already in `out/validation/rows.csv` and run only the
-//!   missing ones (without it the cache starts afresh).
+//!   missing ones (without it the cache starts afresh); with no cache (a fresh
+//!   checkout) it starts from the rows of the committed `docs/validation.md`.
 //!
 //! The table and the plot are written from every cached row, so a report can be built
 //! one case or backend at a time. Each row is printed as it finishes.
@@ -105,6 +106,15 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     if args.get_flag("resume") {
         if let Ok(text) = std::fs::read_to_string(&cache) {
             rows = text.lines().filter_map(Row::from_csv).collect();
+        } else if let Ok(md) = std::fs::read_to_string("docs/validation.md") {
+            // No cache (a fresh checkout): continue from the committed table.
+            rows = table::rows_from_markdown(&md);
+            let text: String = rows.iter().map(|r| r.to_csv() + "\n").collect();
+            std::fs::write(&cache, text)?;
+            println!(
+                "no row cache: {} rows taken from docs/validation.md",
+                rows.len()
+            );
         }
     } else {
         std::fs::write(&cache, "")?;

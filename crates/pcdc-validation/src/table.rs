@@ -796,6 +796,48 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
     s
 }
 
+/// The rows of a table written by [`markdown`] (e.g. the committed
+/// `docs/validation.md`), so that `validation_report --resume` can continue a report on a
+/// machine whose row cache is gone. Values come back at the table's printed precision
+/// (errors to 0.001 % or 3 significant digits, wall times to 0.01 s); lines that are
+/// not rows are skipped.
+pub fn rows_from_markdown(md: &str) -> Vec<Row> {
+    let number = |e: &str| -> Option<f64> {
+        match e.strip_suffix('%') {
+            Some(p) => p.trim().parse::<f64>().ok().map(|v| v / 100.0),
+            None => e.trim().parse().ok(),
+        }
+    };
+    md.lines()
+        .filter_map(|line| {
+            let f: Vec<&str> = line
+                .strip_prefix("| ")?
+                .strip_suffix(" |")?
+                .split(" | ")
+                .collect();
+            // The tolerance text may itself hold " | ": it is what lies between the
+            // seventh field and the last four.
+            if f.len() < 12 || f[0] == "case" || f[0].starts_with("---") {
+                return None;
+            }
+            let n = f.len();
+            Some(Row {
+                case: f[0].into(),
+                variant: f[1].into(),
+                size: f[2].parse().ok()?,
+                elements: f[3].parse().ok()?,
+                backend: f[4].into(),
+                precision: f[5].into(),
+                error: number(f[6])?,
+                tol: f[7..n - 4].join(" | "),
+                pass: f[n - 4] == "yes",
+                steps: f[n - 3].parse().ok()?,
+                wall_s: f[n - 2].parse().ok()?,
+            })
+        })
+        .collect()
+}
+
 fn format_error(e: f64) -> String {
     if e.abs() >= 1e-4 {
         format!("{:.3} %", 100.0 * e)
@@ -867,6 +909,27 @@ mod tests {
         let mut r = row("injection", 1e-13);
         r.tol = "1e-12; width/length ≤ 0.33 (measured 0.06), p_b 12 MPa".into();
         assert_eq!(Row::from_csv(&r.to_csv()), Some(r));
+    }
+
+    #[test]
+    fn rows_come_back_from_the_markdown_table() {
+        let mut failing = row("kirsch", 0.05);
+        failing.tol = "3 % (a | b)".into();
+        let rows = [row("wave_speed", 0.0123456), failing, row("creep", 3.2e-6)];
+        let back = rows_from_markdown(&markdown(&rows, "test machine"));
+        assert_eq!(back.len(), 3);
+        for r in &rows {
+            let b = back.iter().find(|b| b.key() == r.key()).expect("row back");
+            assert_eq!((b.pass, b.steps, b.elements), (r.pass, r.steps, r.elements));
+            assert_eq!(b.tol, r.tol);
+            assert!(
+                (b.error - r.error).abs() <= 1e-4 * r.error.abs(),
+                "{} {}",
+                b.error,
+                r.error
+            );
+            assert!((b.wall_s - r.wall_s).abs() <= 0.005);
+        }
     }
 
     #[test]
