@@ -1153,7 +1153,8 @@ impl<D: Dim> Physics<D> for Contact {
         }
         let k = (3.0 * penalty).max(shear);
         let (mut best, mut which) = (f64::INFINITY, 0);
-        for (n, &m) in kin.mass.iter().enumerate() {
+        // Mesh nodes only: nodes other physics add (bolt nodes) never touch in contact.
+        for (n, &m) in kin.mass.iter().enumerate().take(kin.mesh.n_nodes()) {
             // A node without mass dropped out with its null elements: contact skips it.
             if m == 0.0 {
                 continue;
