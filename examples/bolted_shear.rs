@@ -58,6 +58,22 @@ fn run(backend: &Backend) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>>
         last = Some(out);
     }
     let out = last.expect("three sizes");
+    println!("finest size, window means from {} mm:", bs::FROM * 1e3);
+    println!(
+        "{:>8} {:>10} {:>10} {:>10} {:>10}",
+        "from_mm", "T_kN", "exact_kN", "P_kN", "err_share"
+    );
+    let base = bs::SIGMA_N * bs::LENGTH * bs::FRICTION.to_radians().tan();
+    for w in &out.windows {
+        println!(
+            "{:>8.2} {:>10.2} {:>10.2} {:>10.2} {:>10.4}",
+            w[0] * 1e3,
+            w[1] / 1e3,
+            w[2] / 1e3,
+            w[3] / 1e3,
+            (w[1] - w[2]) / (w[2] - base)
+        );
+    }
     let mm: Vec<f64> = out.samples.iter().map(|s| s.shear * 1e3).collect();
     let png = out_dir("bolted_shear")?.join("shear.png");
     Plot::new(

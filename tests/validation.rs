@@ -540,13 +540,13 @@ fn bolt_pullout_matches_the_closed_form_and_fails_at_the_bond_strength() {
 /// closed form, and the bolt yields in tension as the joint slides.
 #[test]
 fn bolted_shear_adds_the_bolt_force_to_the_joint_friction() {
-    // Coarser than the report and sheared to 5 mm (the bolt yields at 2 mm): a quarter
-    // of the example's cost.
+    // Coarser than the report and sheared to 5 mm (the bolt yields at 2 mm).
     let o = bolted_shear::run(
         &cpu(),
         &bolted_shear::Params {
             size: 0.0625,
             shear: 0.005,
+            velocity: bolted_shear::VELOCITY,
         },
     )
     .unwrap();
