@@ -106,7 +106,7 @@ pub fn axial_force_profile<D: Dim>(
         .get(b)
         .ok_or_else(|| ComputeError::param("bolt index", b, "no such bolt"))?;
     let f = sim.field(BOLT_AXIAL_FORCE)?;
-    let range = bolts.segment_range(b);
+    let range = bolts.segment_range(b).unwrap_or(0..0);
     if range.end > f.len() {
         return Err(ComputeError::param(
             "bolts",

@@ -128,17 +128,20 @@ impl Bolts {
         &self.bolts
     }
 
-    /// Index of the first node of bolt `b` in the set [`BOLT_NODES`] and its node count.
-    pub fn node_range(&self, b: usize) -> std::ops::Range<usize> {
+    /// The indices of bolt `b`'s nodes in the set [`BOLT_NODES`] (head first); `None`
+    /// when there is no bolt `b`.
+    pub fn node_range(&self, b: usize) -> Option<std::ops::Range<usize>> {
+        let bolt = self.bolts.get(b)?;
         let first: usize = self.bolts[..b].iter().map(|x| x.points().len()).sum();
-        first..first + self.bolts[b].points().len()
+        Some(first..first + bolt.points().len())
     }
 
-    /// Index of the first segment of bolt `b` in the set [`BOLT_SEGMENTS`] and its
-    /// segment count.
-    pub fn segment_range(&self, b: usize) -> std::ops::Range<usize> {
+    /// The indices of bolt `b`'s segments in the set [`BOLT_SEGMENTS`] (head first);
+    /// `None` when there is no bolt `b`.
+    pub fn segment_range(&self, b: usize) -> Option<std::ops::Range<usize>> {
+        let bolt = self.bolts.get(b)?;
         let first: usize = self.bolts[..b].iter().map(|x| x.segments()).sum();
-        first..first + self.bolts[b].segments()
+        Some(first..first + bolt.segments())
     }
 
     /// A boundary physics for bolt nodes of these bolts (compose it after them).
@@ -150,7 +153,7 @@ impl Bolts {
                 .enumerate()
                 .map(|(b, x)| {
                     let s = x.material().properties().spacing.unwrap_or(1.0);
-                    (x.name().to_string(), self.node_range(b), s)
+                    (x.name().to_string(), self.node_range(b).unwrap_or(0..0), s)
                 })
                 .collect(),
             items: Vec::new(),

@@ -201,6 +201,7 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
             let mean = (0..BOLTS)
                 .map(|i| {
                     b.segment_range(i)
+                        .unwrap_or(0..0)
                         .map(|s| f[s].abs())
                         .fold(0.0f64, f64::max)
                 })
