@@ -101,6 +101,13 @@ pub enum MeshError {
     /// A serialised mesh is inconsistent with its own elements.
     #[error("inconsistent mesh data: {0}")]
     Inconsistent(String),
+    /// A meshing domain is ill-formed ([`crate::mesher`]): the message names the loop,
+    /// line or edge and what is wrong with it.
+    #[error("meshing domain: {what} {reason}")]
+    Domain { what: String, reason: String },
+    /// The mesher could not mesh a domain to the requested quality.
+    #[error("mesher: {0}")]
+    Mesher(String),
     /// A range is ill-formed (e.g. zero plane normal).
     #[error("invalid range: {0}")]
     InvalidRange(String),

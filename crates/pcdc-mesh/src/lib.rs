@@ -52,4 +52,6 @@ pub use range::{PointPredicate, Range};
 pub mod builders;
 pub mod gmsh;
 pub mod memory;
+#[cfg(feature = "mesher")]
+pub mod mesher;
 pub mod vtu;
