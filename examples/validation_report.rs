@@ -233,6 +233,10 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             missing.join("; ")
         ));
     }
+    // Sections other commands keep in the file (the mesh-sensitivity table).
+    if let Ok(old) = std::fs::read_to_string("docs/validation.md") {
+        md.push_str(&table::kept_sections(&old));
+    }
     std::fs::create_dir_all("docs")?;
     std::fs::write("docs/validation.md", md)?;
     table::plot(

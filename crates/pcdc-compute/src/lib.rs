@@ -59,4 +59,4 @@ pub use physics::{
 pub use simulation::{Simulation, SimulationBuilder, State, DEFAULT_SAFETY};
 pub use stages::{FieldStage, MAX_SUBCYCLE};
 pub use statics::{StaticOptions, StaticReport};
-pub use table::{Table, TimeValue};
+pub use table::{Control, Table, TimeValue};

@@ -96,6 +96,11 @@ pub enum TimeValue {
     Const(f64),
     /// A piecewise-linear table of time.
     Table(Table),
+    /// A value the program sets between steps (a servo, a controller): read when the
+    /// condition is applied, on either backend (GPU conditions read their values on the
+    /// host each step). Not in scene files: it cannot be serialised.
+    #[serde(skip)]
+    Control(Control),
 }
 
 impl TimeValue {
@@ -104,6 +109,7 @@ impl TimeValue {
         match self {
             TimeValue::Const(c) => *c,
             TimeValue::Table(tab) => tab.eval(t),
+            TimeValue::Control(c) => c.get(),
         }
     }
 
@@ -115,6 +121,47 @@ impl TimeValue {
             }
             _ => Ok(()),
         }
+    }
+}
+
+/// A shared value set between steps ([`TimeValue::Control`]): clones share it. Setting
+/// a non-finite value keeps the previous one (a controller's NaN must not reach the
+/// nodes).
+#[derive(Clone, Debug, Default)]
+pub struct Control(std::sync::Arc<std::sync::atomic::AtomicU64>);
+
+impl Control {
+    /// A control holding `value`.
+    pub fn new(value: f64) -> Self {
+        let c = Control::default();
+        c.set(value);
+        c
+    }
+
+    /// Sets the value; ignored unless finite.
+    pub fn set(&self, value: f64) {
+        if value.is_finite() {
+            self.0
+                .store(value.to_bits(), std::sync::atomic::Ordering::Relaxed);
+        }
+    }
+
+    /// The current value.
+    pub fn get(&self) -> f64 {
+        f64::from_bits(self.0.load(std::sync::atomic::Ordering::Relaxed))
+    }
+}
+
+impl PartialEq for Control {
+    /// The same shared cell.
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+impl From<Control> for TimeValue {
+    fn from(c: Control) -> Self {
+        TimeValue::Control(c)
     }
 }
 

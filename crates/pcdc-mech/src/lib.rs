@@ -134,6 +134,7 @@ mod model;
 pub mod mohr_coulomb;
 pub mod output;
 pub mod principal;
+pub mod servo;
 pub mod thermal_strain;
 
 pub use actions::{
@@ -146,4 +147,5 @@ pub use initial_stress::InitialStress;
 pub use mechanics::{Mechanics, SurfaceProperties};
 pub use model::{double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};
 pub use mohr_coulomb::{MohrCoulomb, Softening};
+pub use servo::{ServoGains, StressServo};
 pub use thermal_strain::ThermalStrain;

@@ -13,6 +13,7 @@
 // Index loops mirror the tensor notation of the manual's equations.
 #![allow(clippy::needless_range_loop)]
 
+pub mod calibration;
 pub mod plot;
 pub mod report;
 pub mod scenes;

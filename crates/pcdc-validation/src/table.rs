@@ -647,11 +647,12 @@ pub fn run_job(backend: &Backend, job: &Job) -> Result<Row, SceneError> {
                 o.elements,
                 o.modulus_error,
                 format!(
-                    "{} % (E); UCS/Ts {}–{} (measured {:.1})",
-                    ucs::MODULUS_TOL * 100.0,
+                    "{} % (E vs target); UCS/Ts {}–{} (measured {:.1}); post-peak to {} of peak",
+                    o.modulus_tol * 100.0,
                     ucs::RATIO_BAND.0,
                     ucs::RATIO_BAND.1,
-                    o.ratio
+                    o.ratio,
+                    o.stop_fraction
                 ),
                 o.acceptance() <= 1.0,
                 o.steps,
@@ -970,5 +971,62 @@ mod tests {
         assert!(jobs("kirsch", true)
             .iter()
             .all(|j| j.variant.starts_with("relaxation")));
+    }
+}
+
+/// The sections other commands keep in `docs/validation.md` (e.g. the mesh-sensitivity
+/// table of `examples/mesh_sensitivity.rs`): text between `<!-- section:NAME -->` and
+/// `<!-- end:NAME -->`. The report rewrites the file and carries them over
+/// ([`kept_sections`]); their command replaces its own ([`replace_section`]).
+pub fn kept_sections(md: &str) -> String {
+    let mut out = String::new();
+    let mut rest = md;
+    while let Some(i) = rest.find("<!-- section:") {
+        let tail = &rest[i..];
+        let name_end = tail.find(" -->").unwrap_or(tail.len());
+        let name = &tail["<!-- section:".len()..name_end];
+        let end_tag = format!("<!-- end:{name} -->");
+        match tail.find(&end_tag) {
+            Some(j) => {
+                out.push('\n');
+                out.push_str(&tail[..j + end_tag.len()]);
+                out.push('\n');
+                rest = &tail[j + end_tag.len()..];
+            }
+            None => break,
+        }
+    }
+    out
+}
+
+/// `md` with the section `name` (markers included, see [`kept_sections`]) replaced by
+/// `content`, or appended when it has none.
+pub fn replace_section(md: &str, name: &str, content: &str) -> String {
+    let (start, end) = (
+        format!("<!-- section:{name} -->"),
+        format!("<!-- end:{name} -->"),
+    );
+    let block = format!("{start}\n{}\n{end}", content.trim_end());
+    match (md.find(&start), md.find(&end)) {
+        (Some(i), Some(j)) if j > i => format!("{}{block}{}", &md[..i], &md[j + end.len()..]),
+        _ => format!("{}\n{block}\n", md.trim_end()),
+    }
+}
+
+#[cfg(test)]
+mod section_tests {
+    use super::*;
+
+    #[test]
+    fn sections_survive_a_rewrite_and_replace_in_place() {
+        let md = "# T\n\n| row |\n";
+        let with = replace_section(md, "mesh", "table 1");
+        assert!(with.contains("<!-- section:mesh -->\ntable 1\n<!-- end:mesh -->"));
+        let again = replace_section(&with, "mesh", "table 2");
+        assert!(again.contains("table 2") && !again.contains("table 1"));
+        assert_eq!(again.matches("<!-- section:mesh -->").count(), 1);
+        let kept = kept_sections(&again);
+        assert!(kept.contains("table 2") && !kept.contains("| row |"));
+        assert_eq!(kept_sections(md), "");
     }
 }

@@ -1,7 +1,8 @@
 //! The Brazilian (indirect tensile) test: a rock disc compressed along a diameter between
 //! two steel platens, plane strain.
 //!
-//! Disc (SI units): diameter 0.05 m, 2 mm elements (`builders::disc`), every element
+//! Disc (SI units): diameter 0.05 m, 2 mm elements (unstructured by default,
+//! [`DiscPattern`]), every element
 //! with its own nodes and an intrinsic cohesive joint on every interior face, with the
 //! joints, rock, platens and contact of the UCS scene ([`crate::scenes::ucs`]). The
 //! platens touch the disc's lowest and highest nodes and move towards each other.
@@ -37,16 +38,44 @@ pub struct DiscSize {
     pub diameter: f64,
     /// Element size (m).
     pub mesh_size: f64,
+    /// Triangulation.
+    pub pattern: DiscPattern,
+    /// Seed of the unstructured mesh.
+    pub seed: u64,
 }
 
 impl Default for DiscSize {
-    /// D = 50 mm, 2 mm elements.
+    /// D = 50 mm, 2 mm elements, unstructured, seed 0.
     fn default() -> Self {
         DiscSize {
             diameter: 0.05,
             mesh_size: 0.002,
+            pattern: DiscPattern::Unstructured,
+            seed: 0,
         }
     }
+}
+
+/// How the disc is triangulated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DiscPattern {
+    /// Concentric rings of nodes stitched into bands ([`builders::disc`]).
+    Rings,
+    /// An unstructured quality mesh ([`pcdc_mesh::mesher::disc`]). The default.
+    #[default]
+    Unstructured,
+}
+
+/// The disc's mesh (one body), centre (0, D/2).
+pub fn specimen(p: &Params) -> Result<pcdc_mesh::Mesh<pcdc_mesh::Dim2>, SceneError> {
+    let d = p.disc.diameter;
+    Ok(match p.disc.pattern {
+        DiscPattern::Rings => builders::disc([0.0, 0.5 * d], 0.5 * d, p.disc.mesh_size)?,
+        DiscPattern::Unstructured => {
+            pcdc_mesh::mesher::disc([0.0, 0.5 * d], 0.5 * d, p.disc.mesh_size, p.disc.seed)?
+        }
+    })
 }
 
 /// The scene tag of a Brazilian scene file (`scene = "brazilian"`).
@@ -212,7 +241,7 @@ pub fn run(
     p.validate()?;
     p.check_memory()?;
     let d = p.disc.diameter;
-    let specimen = builders::disc([0.0, 0.5 * d], 0.5 * d, p.disc.mesh_size)?;
+    let specimen = specimen(p)?;
     let raw = platen_test::run(
         backend,
         &platen_test::Setup {
@@ -225,6 +254,7 @@ pub fn run(
             loading: &p.loading,
             output: &p.output,
             name: "brazilian",
+            confinement: None,
         },
         progress,
     )?;

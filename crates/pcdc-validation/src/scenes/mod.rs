@@ -10,6 +10,7 @@
 //! bounds and memory guard are in [`limits`].
 
 pub mod benchmark;
+pub mod biaxial;
 pub mod block_sliding;
 pub mod bolt_pullout;
 pub mod bolted_shear;

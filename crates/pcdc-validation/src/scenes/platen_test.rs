@@ -19,7 +19,7 @@ use pcdc_cohesive::{
 };
 use pcdc_compute::{Backend, BackendKind, Simulation, Table, TimeValue};
 use pcdc_contact::Contact;
-use pcdc_mech::{output, Boundary, LinearElastic};
+use pcdc_mech::{output, Boundary, LinearElastic, ServoGains, StressServo};
 use pcdc_mesh::vtu::{DataArray, PvdSeries};
 use pcdc_mesh::{builders, split_nodes, Dim2, Mesh, Range};
 
@@ -32,7 +32,7 @@ use super::limits::{
 
 /// Checks Poisson's ratio: −1 < ν < 0.5 (bulk and shear moduli positive; ν < 0 is allowed
 /// for auxetic materials).
-fn poisson(key: &str, value: f64) -> Result<(), ParamError> {
+pub(crate) fn poisson(key: &str, value: f64) -> Result<(), ParamError> {
     if value > -1.0 && value < 0.5 {
         Ok(())
     } else {
@@ -45,7 +45,7 @@ fn poisson(key: &str, value: f64) -> Result<(), ParamError> {
 }
 
 /// Checks an elastic modulus: positive, finite and at most [`MAX_MODULUS`].
-fn modulus(key: &str, value: f64) -> Result<(), ParamError> {
+pub(crate) fn modulus(key: &str, value: f64) -> Result<(), ParamError> {
     positive(key, value)?;
     at_most(
         key,
@@ -429,6 +429,41 @@ impl Output {
     }
 }
 
+/// Servo-controlled confinement of a rectangular specimen's sides (biaxial test, PFC's
+/// servo walls): each side's nodes form a smooth rigid wall (x velocity from a
+/// [`StressServo`], y free) that holds the confining stress σ3. The test first
+/// consolidates: the sides and the platens are servo-controlled to σ3 until all four
+/// hold it within `tolerance` over a record window; then the platens load at
+/// `loading.platen_velocity` (ramped) while the sides keep σ3.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Confinement {
+    /// Confining stress σ3 (Pa, compression positive, > 0).
+    pub stress: f64,
+    /// Servo response time τ (s): a few P-wave transits of the specimen's width.
+    pub response_time: f64,
+    /// Largest wall speed (m/s).
+    pub max_speed: f64,
+    /// Relative tolerance on σ3 that ends the consolidation.
+    pub tolerance: f64,
+}
+
+impl Confinement {
+    /// Checks every value.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        positive("confinement.stress", self.stress)?;
+        positive("confinement.response_time", self.response_time)?;
+        positive("confinement.max_speed", self.max_speed)?;
+        within(
+            "confinement.tolerance",
+            self.tolerance,
+            1e-6,
+            0.5,
+            "must lie in 1e-6 to 0.5",
+        )
+    }
+}
+
 /// Validates the groups shared by both scenes.
 pub(crate) fn validate_common(
     rock: &Rock,
@@ -471,6 +506,14 @@ pub struct Sample {
     pub closure: f64,
     /// Shortening of the specimen between its top and bottom nodes (m).
     pub shortening: f64,
+    /// Confining stress on the sides (Pa, compression positive): the mean of both
+    /// servo walls over the record window; 0 without confinement.
+    pub confinement: f64,
+    /// Widening of the specimen: mean x displacement of its rightmost nodes minus that
+    /// of its leftmost ones, both over the middle half of its height, away from the
+    /// platens' end restraint (m; the lateral strain of a rectangular sample times its
+    /// width).
+    pub widening: f64,
     /// Load per unit thickness (N/m): mean of the top and bottom platen reactions,
     /// compression positive.
     pub load: f64,
@@ -505,6 +548,11 @@ impl BrokenCount {
 pub struct Crack {
     /// Midpoint of the joint in the undeformed mesh (m).
     pub at: [f64; 2],
+    /// Direction of the joint's trace from the x axis (degrees, 0-180): 90 is a vertical
+    /// crack (parallel to the UCS load).
+    pub angle_deg: f64,
+    /// Length of the joint (m).
+    pub length: f64,
     /// Failure mode.
     pub mode: FailureMode,
 }
@@ -552,6 +600,8 @@ pub(crate) struct Setup<'a> {
     pub output: &'a Output,
     /// Base name of the VTU series.
     pub name: &'a str,
+    /// Servo-controlled side confinement (biaxial test), if any.
+    pub confinement: Option<&'a Confinement>,
 }
 
 /// Runs the platen test: builds specimen + platens, splits the specimen into FDEM
@@ -602,6 +652,22 @@ pub(crate) fn run(
     let loaded_top = at_y(&top_nodes, y1 + ph);
     let spec_top = at_y(&spec_nodes, y1);
     let spec_bottom = at_y(&spec_nodes, y0);
+    let at_x = |x: f64| -> Vec<u32> {
+        (spec_nodes.iter().copied())
+            .filter(|&n| {
+                let q = mesh.node(n as usize);
+                (q[0] - x).abs() <= eps && (q[1] - 0.5 * (y0 + y1)).abs() <= 0.25 * height
+            })
+            .collect()
+    };
+    let (spec_left, spec_right) = (at_x(lo[0]), at_x(hi[0]));
+    let width = hi[0] - lo[0];
+    let side = |x: f64| -> Vec<u32> {
+        (spec_nodes.iter().copied())
+            .filter(|&n| (mesh.node(n as usize)[0] - x).abs() <= eps)
+            .collect()
+    };
+    let (side_left, side_right) = (side(lo[0]), side(hi[0]));
     if loaded_bottom.is_empty() || loaded_top.is_empty() || spec_top.is_empty() {
         return Err(SceneError::Measurement(
             "platen test: no loaded or measured nodes found".into(),
@@ -610,6 +676,35 @@ pub(crate) fn run(
     let mut mesh = mesh;
     mesh.add_node_group("platen_bottom_edge", loaded_bottom.clone())?;
     mesh.add_node_group("platen_top_edge", loaded_top.clone())?;
+    // Servos of the biaxial test: the sides (whole height) and, while consolidating,
+    // the platens; gains from the rock's P-wave modulus over the span.
+    let mut servos = match s.confinement {
+        Some(c) => {
+            c.validate()?;
+            // P-wave moduli and impedances of rock and steel: the sides drive the rock,
+            // the platens the steel (the stiffer, heavier body limits their gain).
+            let wave = |e: f64, nu: f64| e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+            let m_rock = wave(s.rock.young, s.rock.poisson);
+            let m_steel = wave(s.platens.young, s.platens.poisson);
+            let z_rock = (m_rock * s.rock.density).sqrt();
+            let z_steel = (m_steel * s.platens.density).sqrt();
+            let side_gains = ServoGains::for_specimen(m_rock, width, c.response_time, z_rock);
+            let platen_gains =
+                ServoGains::for_specimen(m_rock, height, c.response_time, z_steel.max(z_rock));
+            let servo = |nodes: Vec<u32>, axis, inward, area, gains| {
+                StressServo::new(nodes, axis, inward, area, c.stress, gains, c.max_speed)
+            };
+            mesh.add_node_group("servo_left", side_left.clone())?;
+            mesh.add_node_group("servo_right", side_right.clone())?;
+            Some([
+                servo(side_left, 0, 1.0, height, side_gains)?,
+                servo(side_right, 0, -1.0, height, side_gains)?,
+                servo(loaded_bottom.clone(), 1, 1.0, width, platen_gains)?,
+                servo(loaded_top.clone(), 1, -1.0, width, platen_gains)?,
+            ])
+        }
+        None => None,
+    };
 
     let e = s.rock.young;
     let rock = s.rock.model()?;
@@ -632,19 +727,37 @@ pub(crate) fn run(
             Ok((sign * v).into())
         }
     };
+    let boundary = match &servos {
+        None => Boundary::new()
+            .velocity(
+                Range::group("platen_bottom_edge"),
+                [Some(0.0.into()), Some(table(1.0)?), None],
+            )
+            .velocity(
+                Range::group("platen_top_edge"),
+                [Some(0.0.into()), Some(table(-1.0)?), None],
+            ),
+        Some([left, right, bottom, top]) => Boundary::new()
+            .velocity(
+                Range::group("servo_left"),
+                [Some(left.velocity()), None, None],
+            )
+            .velocity(
+                Range::group("servo_right"),
+                [Some(right.velocity()), None, None],
+            )
+            .velocity(
+                Range::group("platen_bottom_edge"),
+                [Some(0.0.into()), Some(bottom.velocity()), None],
+            )
+            .velocity(
+                Range::group("platen_top_edge"),
+                [Some(0.0.into()), Some(top.velocity()), None],
+            ),
+    };
     let mut sim = Simulation::builder(mesh, backend.clone())
         .group(Fdem::new(rock, czm, contact).material(in_specimen.clone().complement(), steel))
-        .physics(
-            Boundary::new()
-                .velocity(
-                    Range::group("platen_bottom_edge"),
-                    [Some(0.0.into()), Some(table(1.0)?), None],
-                )
-                .velocity(
-                    Range::group("platen_top_edge"),
-                    [Some(0.0.into()), Some(table(-1.0)?), None],
-                ),
-        )
+        .physics(boundary)
         .build()?;
     let dt = sim.dt();
     let dt_limit = sim
@@ -653,7 +766,12 @@ pub(crate) fn run(
         .unwrap_or_default();
     // Time to close by max_closure · height, plus the ramp's lost travel.
     let t_max = s.loading.max_closure * height / (2.0 * v) + 0.5 * ramp;
-    let max_steps = (t_max / dt).ceil() as u64;
+    // Consolidation may take up to 40 response times of the slowest servo.
+    let t_consolidate = match (&servos, s.confinement) {
+        (Some(sv), Some(c)) => 40.0 * c.response_time.max(sv[2].response_time()),
+        _ => 0.0,
+    };
+    let max_steps = ((t_max + t_consolidate) / dt).ceil() as u64;
     let every = s.loading.record_every.max(1);
     let mut series = if s.output.frames > 0 {
         Some(PvdSeries::new(&s.output.dir, s.name)?)
@@ -674,8 +792,36 @@ pub(crate) fn run(
     let mut samples = Vec::new();
     let (mut acc, mut count) = (0.0, 0u64);
     let (mut peak, mut peak_index) = (0.0f64, 0usize);
+    // Consolidation (with servos): window means of the four walls' stresses; the
+    // loading starts at `load_start` (s), measured from the values there.
+    let mut loading = servos.is_none();
+    let mut wall_acc = [0.0f64; 4];
+    let mut load_start = 0.0;
+    let mut base = [0.0f64; 3];
     loop {
         sim.run(chunk)?;
+        if let Some(servos) = servos.as_mut() {
+            let stop = if loading { 2 } else { 4 };
+            for (k, servo) in servos.iter_mut().enumerate().take(stop) {
+                wall_acc[k] += servo.update(&sim);
+            }
+            if loading {
+                let ramped = if ramp > 0.0 {
+                    ((sim.state.time - load_start) / ramp).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                servos[2].drive(v * ramped);
+                servos[3].drive(v * ramped);
+                // Feed-forward of the sides: the elastic lateral expansion the axial
+                // loading causes, ν' ε̇ W / 2 outward per side with the elements'
+                // plane-strain ν' = ν/(1 − ν) (the PI corrects the estimate).
+                let nu = s.rock.poisson;
+                let expansion = nu / (1.0 - nu) * (2.0 * v * ramped / height) * 0.5 * width;
+                servos[0].set_feed_forward(-expansion);
+                servos[1].set_feed_forward(-expansion);
+            }
+        }
         let f = sim.node_force();
         // Reactions: the gathered force on the held edge nodes is what the specimen and
         // platen push back with; compression pushes the bottom edge down (−y) and the top
@@ -686,11 +832,52 @@ pub(crate) fn run(
         acc += 0.5 * (rb + rt);
         count += 1;
         let step = sim.state.step;
+        if step % every == 0 && !loading {
+            // Consolidating: start the loading once every wall holds σ3.
+            let c = s.confinement.expect("servos come with a confinement");
+            let means = wall_acc.map(|a| a / count as f64);
+            (acc, count, wall_acc) = (0.0, 0, [0.0; 4]);
+            if means
+                .iter()
+                .all(|m| (m - c.stress).abs() <= c.tolerance * c.stress)
+            {
+                loading = true;
+                load_start = sim.state.time;
+                base = [
+                    mean_y(&sim, &loaded_bottom) - mean_y(&sim, &loaded_top),
+                    mean_y(&sim, &spec_bottom) - mean_y(&sim, &spec_top),
+                    0.0,
+                ];
+                let mean_x = |list: &[u32]| {
+                    list.iter()
+                        .map(|&n| sim.state.u[2 * n as usize])
+                        .sum::<f64>()
+                        / list.len().max(1) as f64
+                };
+                base[2] = mean_x(&spec_right) - mean_x(&spec_left);
+            } else if sim.state.time > t_consolidate {
+                return Err(SceneError::Measurement(format!(
+                    "biaxial consolidation: the servo walls did not hold {:.3e} Pa within {:.1} % after {:.3e} s (stresses {means:?} Pa); raise confinement.response_time",
+                    c.stress,
+                    100.0 * c.tolerance,
+                    t_consolidate
+                )));
+            }
+            continue;
+        }
         if step % every == 0 {
             let load = acc / count as f64;
-            (acc, count) = (0.0, 0);
-            let closure = mean_y(&sim, &loaded_bottom) - mean_y(&sim, &loaded_top);
-            let shortening = mean_y(&sim, &spec_bottom) - mean_y(&sim, &spec_top);
+            let confinement = 0.5 * (wall_acc[0] + wall_acc[1]) / count as f64;
+            (acc, count, wall_acc) = (0.0, 0, [0.0; 4]);
+            let closure = mean_y(&sim, &loaded_bottom) - mean_y(&sim, &loaded_top) - base[0];
+            let shortening = mean_y(&sim, &spec_bottom) - mean_y(&sim, &spec_top) - base[1];
+            let mean_x = |list: &[u32]| {
+                list.iter()
+                    .map(|&n| sim.state.u[2 * n as usize])
+                    .sum::<f64>()
+                    / list.len().max(1) as f64
+            };
+            let widening = mean_x(&spec_right) - mean_x(&spec_left) - base[2];
             // Kinetic energy of the specimen relative to the uniform compression between
             // the platens' current velocities (the motion a quasi-static test has).
             let mean_vy = |list: &[u32]| {
@@ -716,6 +903,8 @@ pub(crate) fn run(
                 time: sim.state.time,
                 closure,
                 shortening,
+                widening,
+                confinement,
                 load,
                 kinetic,
                 strain_energy: sim.stored_energy(),
@@ -820,6 +1009,11 @@ fn broken_joints(
         );
         cracks.push(Crack {
             at: [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])],
+            angle_deg: (b[1] - a[1])
+                .atan2(b[0] - a[0])
+                .to_degrees()
+                .rem_euclid(180.0),
+            length: (b[0] - a[0]).hypot(b[1] - a[1]),
             mode,
         });
     }
