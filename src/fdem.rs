@@ -79,6 +79,26 @@ impl Fdem {
         self.joints = self.joints.model(range, model);
         self
     }
+
+    /// Assigns a constitutive model to the listed elements (e.g. a class of a
+    /// heterogeneous modulus, `pcdc_mesh::property::classes`); later assignments
+    /// override earlier ones.
+    pub fn material_for(
+        mut self,
+        elements: Vec<u32>,
+        model: impl ConstitutiveModel + 'static,
+    ) -> Self {
+        self.mechanics = self.mechanics.material_for(elements, model);
+        self
+    }
+
+    /// Assigns a joint model to the listed joints (indices into the mesh's
+    /// interfaces, e.g. a class of a heterogeneous strength); later assignments
+    /// override earlier ones.
+    pub fn joint_model_for(mut self, joints: Vec<u32>, model: impl JointModel + 'static) -> Self {
+        self.joints = self.joints.model_for(joints, model);
+        self
+    }
 }
 
 impl<D: Dim> PhysicsGroup<D> for Fdem {

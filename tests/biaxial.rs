@@ -76,9 +76,9 @@ fn bad_servo_parameters_are_named() {
     };
     let e = StressServo::new(vec![0], 0, 1.0, 1.0, 1e6, bad, 1.0).unwrap_err();
     assert!(e.to_string().contains("proportional"), "{e}");
-    // The impedance caps the gain: K_p Z = 0.25.
+    // The impedance caps the gain: K_p Z = 0.5.
     let stiff = ServoGains::for_specimen(30e9, 0.05, 1e-9, 4e7);
-    assert!((stiff.proportional * 4e7 - 0.25).abs() < 1e-12);
+    assert!((stiff.proportional * 4e7 - 0.5).abs() < 1e-12);
     let mut p = biaxial::Params::reduced();
     p.pressures = vec![5e6];
     assert!(biaxial::run(&Backend::cpu(1).unwrap(), &p, &mut |_| {}).is_err());

@@ -141,3 +141,50 @@ fn gpu_loading_branch_follows_the_cpu() {
     assert!(worst < 2e-3, "stress differs by {worst:e} of the top");
     assert!((cpu.young - dev.young).abs() < 2e-3 * cpu.young);
 }
+
+/// Heterogeneous rock (Weibull joint strengths, normal element moduli, seeded): the
+/// sample gets weaker than the homogeneous one (its weakest joints start the failure)
+/// and its modulus stays at the target within the acceptance; bad input is named (the
+/// fields' own seeding and statistics are tested in `pcdc_mesh::property`).
+#[test]
+fn heterogeneous_rock_is_weaker() {
+    use pcdc::mesh::property::{PropertyField, Randomness};
+    use pcdc_validation::scenes::platen_test::Heterogeneity;
+    let cpu = Backend::cpu(2).unwrap();
+    let mut p = ucs::Params::reduced();
+    p.sample.mesh_size = 0.006;
+    p.loading.stop_fraction = 0.7;
+    let plain = ucs::run(&cpu, &p, &mut |_| {}).unwrap();
+    p.heterogeneity = Some(Heterogeneity {
+        modulus: Some(PropertyField {
+            mean: 1.0,
+            gradient: None,
+            random: Some(Randomness::Normal { cov: 0.1 }),
+            seed: 1,
+        }),
+        strength: Some(PropertyField {
+            mean: 1.0,
+            gradient: None,
+            random: Some(Randomness::Weibull { modulus: 4.0 }),
+            seed: 2,
+        }),
+        classes: 16,
+    });
+    let a = ucs::run(&cpu, &p, &mut |_| {}).unwrap();
+    eprintln!(
+        "homogeneous UCS {:.2} MPa, E {:.3} GPa; heterogeneous UCS {:.2} MPa, E {:.3} GPa",
+        plain.ucs / 1e6,
+        plain.young / 1e9,
+        a.ucs / 1e6,
+        a.young / 1e9
+    );
+    assert!(a.ucs < plain.ucs, "{} vs {}", a.ucs, plain.ucs);
+    assert!(a.modulus_error <= ucs::MODULUS_TOL, "{}", a.modulus_error);
+    // Bad input is named.
+    let mut bad = p.clone();
+    bad.heterogeneity.as_mut().unwrap().classes = 0;
+    assert!(ucs::run(&cpu, &bad, &mut |_| {})
+        .unwrap_err()
+        .to_string()
+        .contains("heterogeneity.classes"));
+}

@@ -74,6 +74,8 @@ pub struct SurfaceProperties {
 #[derive(Debug, Default)]
 pub struct Mechanics {
     assignments: Vec<Assignment>,
+    /// Assignments by element list: (index into `assignments`, elements).
+    explicit: Vec<(usize, Vec<u32>)>,
     initial_stress: Vec<(Range, InitialStress)>,
     models: Vec<Arc<dyn ConstitutiveModel>>,
     /// Per model (as `models`): the constants the element loop reads.
@@ -135,6 +137,17 @@ impl Mechanics {
         self
     }
 
+    /// Assigns a constitutive model to the listed elements (e.g. one class of a
+    /// heterogeneous property, `pcdc_mesh::property::classes`); later assignments
+    /// override earlier ones. An index beyond the mesh is an error when the simulation
+    /// is built.
+    pub fn material_for(self, elements: Vec<u32>, model: impl ConstitutiveModel + 'static) -> Self {
+        let at = self.assignments.len();
+        let mut m = self.material(Range::custom(|_| false), model);
+        m.explicit.push((at, elements));
+        m
+    }
+
     /// Assigns a shared model (e.g. a user plugin behind an `Arc`).
     pub fn material_arc(mut self, range: Range, model: Arc<dyn ConstitutiveModel>) -> Self {
         self.assignments.push((range, model, None));
@@ -179,7 +192,19 @@ impl Mechanics {
         let mut material = vec![u16::MAX; ne];
         let mut models = Vec::new();
         for (i, (range, model, _)) in self.assignments.iter().enumerate() {
-            let sel = mesh.select_elements(range)?;
+            let sel = match self.explicit.iter().find(|(at, _)| *at == i) {
+                Some((_, list)) => {
+                    if let Some(&bad) = list.iter().find(|&&e| e as usize >= ne) {
+                        return Err(MechError::param(
+                            format!("material {i} ({}) element", model.name()),
+                            bad,
+                            format!("the mesh has {ne} elements"),
+                        ));
+                    }
+                    list.clone()
+                }
+                None => mesh.select_elements(range)?,
+            };
             if sel.is_empty() {
                 return Err(MechError::EmptyRange {
                     what: format!("material {} ({})", i, model.name()),

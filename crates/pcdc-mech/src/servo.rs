@@ -12,18 +12,19 @@
 //!
 //! with an optional feed-forward speed v_ff ([`StressServo::set_feed_forward`]),
 //!
-//! with K_p = min(span / (M τ), 0.25 / Z) ([`ServoGains::for_specimen`]): a stress
+//! with K_p = min(span / (M τ), 0.5 / Z) ([`ServoGains::for_specimen`]): a stress
 //! error closes in about τ through a specimen of modulus M and span (the distance to the
 //! opposite wall), but no faster than the wall's impedance Z = ρ c allows: a velocity
-//! step Δv sends a stress ρ c Δv into the body behind the wall at once, so a gain
-//! K_p Z ≥ 1 makes the loop flip the wall's speed every update (measured: a steel platen
-//! with K_p Z = 2.4 oscillated at ±1 m/s). K_i = K_p / (4 τ) with the response time
-//! τ = span / (M K_p) the gain gives (the wall on its specimen is an integrating plant,
-//! σ̇ = (M / span) v, and 4 τ damps the PI loop critically, ζ = √4 / 2 = 1: no overshoot to
-//! speak of). The integral term supplies the steady speed a wall needs to follow a specimen that keeps
-//! expanding (a biaxial test's lateral dilation), which a proportional servo (PFC's)
-//! can only follow with a lag error. The speed is capped at `max_speed`, and the
-//! integral stops growing while capped (no wind-up). A response time of a few P-wave
+//! step Δv sends a stress ρ c Δv into the body behind the wall at once, so the error
+//! after an update is (1 − K_p Z) times the one before: K_p Z ≥ 1 flips the wall's speed
+//! every update (measured: a steel platen with K_p Z = 2.4 oscillated at ±1 m/s), and
+//! 0.5 halves the error per update without overshoot. K_i = K_p / (2 τ) with the
+//! response time τ = span / (M K_p) the gain gives (the wall on its specimen is an
+//! integrating plant, σ̇ = (M / span) v, and 2 τ damps the PI loop at ζ = √2 / 2 ≈ 0.7).
+//! The integral term supplies the steady speed a wall needs to follow a specimen that
+//! keeps expanding (a biaxial test's lateral dilation), which a proportional servo
+//! (PFC's) can only follow with a lag error. The speed is capped at `max_speed`, and
+//! the integral stops growing while capped (no wind-up). A response time of a few P-wave
 //! transits of the span keeps the loop stable against the specimen's own dynamics.
 
 use pcdc_compute::{Control, Simulation, TimeValue};
@@ -46,11 +47,11 @@ impl ServoGains {
     /// (ρ c, Pa·s/m) of the body the wall drives or pushes, whichever is larger (module
     /// docs).
     pub fn for_specimen(modulus: f64, span: f64, tau: f64, impedance: f64) -> Self {
-        let kp = (span / (modulus * tau)).min(0.25 / impedance);
+        let kp = (span / (modulus * tau)).min(0.5 / impedance);
         let tau_eff = span / (modulus * kp);
         ServoGains {
             proportional: kp,
-            integral_time: 4.0 * tau_eff,
+            integral_time: 2.0 * tau_eff,
         }
     }
 
@@ -140,9 +141,9 @@ impl StressServo {
     }
 
     /// The response time of the proportional gain on the servo's own terms: the integral
-    /// time / 4 (s).
+    /// time / 2 (s).
     pub fn response_time(&self) -> f64 {
-        self.kp / self.ki / 4.0
+        self.kp / self.ki / 2.0
     }
 
     /// The nodes.

@@ -54,4 +54,6 @@ pub mod gmsh;
 pub mod memory;
 #[cfg(feature = "mesher")]
 pub mod mesher;
+#[cfg(feature = "property")]
+pub mod property;
 pub mod vtu;

@@ -42,8 +42,8 @@ pub struct Params {
 
 impl Params {
     /// The series on the UCS quick start's sample (calibrated rock, 2 mm mesh) at
-    /// [`PRESSURES`]; servo response 50 µs (about three P-wave transits of the 52 mm
-    /// width), walls at most 1 m/s. Each test stops once the stress has fallen to 90 %
+    /// [`PRESSURES`]; servo response 25 µs (about 1.5 P-wave transits of the 52 mm
+    /// width; the impedance limit of the gain binds first), walls at most 1 m/s. Each test stops once the stress has fallen to 90 %
     /// of its peak (a confined sample keeps most of its strength after the peak; run on,
     /// it compacts and hardens).
     pub fn full() -> Self {
@@ -54,7 +54,7 @@ impl Params {
         Params {
             sample,
             pressures: PRESSURES.to_vec(),
-            response_time: 5e-5,
+            response_time: 2.5e-5,
             max_speed: 1.0,
         }
     }

@@ -255,6 +255,7 @@ pub fn run(
             output: &p.output,
             name: "brazilian",
             confinement: None,
+            heterogeneity: None,
         },
         progress,
     )?;

@@ -20,6 +20,7 @@ use pcdc_cohesive::{
 use pcdc_compute::{Backend, BackendKind, Simulation, Table, TimeValue};
 use pcdc_contact::Contact;
 use pcdc_mech::{output, Boundary, LinearElastic, ServoGains, StressServo};
+use pcdc_mesh::property::{classes, PropertyField};
 use pcdc_mesh::vtu::{DataArray, PvdSeries};
 use pcdc_mesh::{builders, split_nodes, Dim2, Mesh, Range};
 
@@ -464,6 +465,59 @@ impl Confinement {
     }
 }
 
+/// Heterogeneous rock (PFC's property ranges and gradients): factor fields (mean 1
+/// keeps the rock's values on average) on the elements' Young's modulus and on the
+/// joints' strengths, evaluated at element centroids and joint midpoints and binned
+/// into `classes` quantile classes, each with its own model
+/// ([`pcdc_mesh::property::classes`]). A strength factor f scales the cohesion and the
+/// tensile strength by f and the fracture energies by f² (the cohesive-zone length
+/// stays the rock's). The joints' penalties stay multiples of the mean E.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Heterogeneity {
+    /// Factor on the elements' E, if any.
+    #[serde(default)]
+    pub modulus: Option<PropertyField>,
+    /// Factor on the joints' strengths, if any.
+    #[serde(default)]
+    pub strength: Option<PropertyField>,
+    /// Quantile classes per field (1-1000; 16 resolves a Weibull m ≥ 3 to a few per
+    /// cent of its spread).
+    #[serde(default = "default_classes")]
+    pub classes: usize,
+}
+
+fn default_classes() -> usize {
+    16
+}
+
+impl Heterogeneity {
+    /// Checks every value.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        within(
+            "heterogeneity.classes",
+            self.classes as f64,
+            1.0,
+            1000.0,
+            "must lie in 1-1000",
+        )?;
+        for (key, f) in [
+            ("heterogeneity.modulus", &self.modulus),
+            ("heterogeneity.strength", &self.strength),
+        ] {
+            if let Some(f) = f {
+                f.validate().map_err(|_| ParamError {
+                    key: key.into(),
+                    value: f.mean,
+                    reason: "needs a positive finite mean, a finite non-zero gradient direction, a normal cov in [0, 1) or a Weibull modulus >= 1",
+                })?;
+                positive(&format!("{key}.mean"), f.mean)?;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Validates the groups shared by both scenes.
 pub(crate) fn validate_common(
     rock: &Rock,
@@ -602,6 +656,8 @@ pub(crate) struct Setup<'a> {
     pub name: &'a str,
     /// Servo-controlled side confinement (biaxial test), if any.
     pub confinement: Option<&'a Confinement>,
+    /// Heterogeneous rock, if any.
+    pub heterogeneity: Option<&'a Heterogeneity>,
 }
 
 /// Runs the platen test: builds specimen + platens, splits the specimen into FDEM
@@ -755,8 +811,12 @@ pub(crate) fn run(
                 [Some(0.0.into()), Some(top.velocity()), None],
             ),
     };
+    let mut fdem = Fdem::new(rock, czm, contact).material(in_specimen.clone().complement(), steel);
+    if let Some(h) = s.heterogeneity {
+        fdem = heterogeneous(fdem, h, &mesh, n_spec, s)?;
+    }
     let mut sim = Simulation::builder(mesh, backend.clone())
-        .group(Fdem::new(rock, czm, contact).material(in_specimen.clone().complement(), steel))
+        .group(fdem)
         .physics(boundary)
         .build()?;
     let dt = sim.dt();
@@ -959,6 +1019,56 @@ pub(crate) fn run(
         wall_s: start.elapsed().as_secs_f64(),
         pvd,
     })
+}
+
+/// The heterogeneity's classes as models on the specimen's elements (`0..n_spec`) and
+/// on the joints.
+fn heterogeneous(
+    mut fdem: Fdem,
+    h: &Heterogeneity,
+    mesh: &Mesh<Dim2>,
+    n_spec: usize,
+    s: &Setup<'_>,
+) -> Result<Fdem, SceneError> {
+    h.validate()?;
+    if let Some(field) = &h.modulus {
+        let mut c = [0.0; 2];
+        let pts: Vec<f64> = (0..n_spec)
+            .flat_map(|e| {
+                mesh.element_centroid(e, &mut c);
+                c
+            })
+            .collect();
+        for class in classes(&field.values(&pts, 2)?, h.classes)? {
+            let rock = Rock {
+                young: s.rock.young * class.value,
+                ..s.rock.clone()
+            };
+            fdem = fdem.material_for(class.members, rock.model()?);
+        }
+    }
+    if let Some(field) = &h.strength {
+        let joints = mesh.interfaces();
+        let pts: Vec<f64> = (0..joints.len())
+            .flat_map(|j| {
+                let n = &joints.nodes()[4 * j..4 * j + 2];
+                let (a, b) = (mesh.node(n[0] as usize), mesh.node(n[1] as usize));
+                [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
+            })
+            .collect();
+        for class in classes(&field.values(&pts, 2)?, h.classes)? {
+            let f = class.value;
+            let j = JointParams {
+                cohesion: s.joints.cohesion * f,
+                tensile_strength: s.joints.tensile_strength * f,
+                gf1: s.joints.gf1 * f * f,
+                gf2: s.joints.gf2 * f * f,
+                ..s.joints.clone()
+            };
+            fdem = fdem.joint_model_for(class.members, j.model(s.rock.young)?);
+        }
+    }
+    Ok(fdem)
 }
 
 /// Steps between two reads of the platen reaction: every step on the CPU, where reading

@@ -36,8 +36,8 @@ use pcdc_compute::Backend;
 use pcdc_mesh::builders;
 
 use super::platen_test::{
-    self, positive, BrokenCount, Confinement, ContactParams, Crack, JointParams, Loading, Output,
-    ParamError, Platens, Progress, Rock, Sample,
+    self, positive, BrokenCount, Confinement, ContactParams, Crack, Heterogeneity, JointParams,
+    Loading, Output, ParamError, Platens, Progress, Rock, Sample,
 };
 use crate::report::SceneError;
 
@@ -341,6 +341,8 @@ pub struct Params {
     /// Servo-controlled confinement of the sides (a biaxial test, see
     /// [`crate::scenes::biaxial`]); none for the UCS test.
     pub confinement: Option<Confinement>,
+    /// Heterogeneous rock (random or graded E and joint strengths); none by default.
+    pub heterogeneity: Option<Heterogeneity>,
     /// Contact.
     pub contact: ContactParams,
     /// Loading.
@@ -372,6 +374,7 @@ impl Default for Params {
             }),
             joints: calibrated_joints(),
             confinement: None,
+            heterogeneity: None,
             contact: ContactParams::default(),
             loading: Loading {
                 platen_velocity: 0.2,
@@ -450,6 +453,9 @@ impl Params {
     pub fn validate(&self) -> Result<(), ParamError> {
         if let Some(c) = &self.confinement {
             c.validate()?;
+        }
+        if let Some(h) = &self.heterogeneity {
+            h.validate()?;
         }
         if let Some(t) = &self.target {
             platen_test::modulus("target.young", t.young)?;
@@ -779,6 +785,7 @@ pub fn run(
             output: &p.output,
             name: "ucs",
             confinement: p.confinement.as_ref(),
+            heterogeneity: p.heterogeneity.as_ref(),
         },
         progress,
     )?;
