@@ -5,8 +5,9 @@
 //!
 //! `cargo run --release --example calibrate` calibrates for E = 30 GPa, ν = 0.25,
 //! UCS = 100 MPa, Brazilian strength 8 MPa on 2 mm meshes; `--young`, `--poisson`,
-//! `--ucs`, `--tensile` (Pa), `--mesh-size` (m), `--seed` and `--max-rounds` change
-//! that. It prints every round, then how many virtual tests it ran and how long it took,
+//! `--ucs`, `--tensile` (Pa), `--mesh-size` (m), `--seed`, `--meshes` (meshes averaged
+//! per round, so that the parameters fit the rock rather than one mesh) and
+//! `--max-rounds` change that. It prints every round, then how many virtual tests it ran and how long it took,
 //! and writes under `out/calibrate/`: `calibrated.toml` (the `[rock]` and `[joints]`
 //! tables to paste into a UCS or Brazilian scene file) and `report.csv` (one line per
 //! round: parameters tried, measured values, errors). The RESULT metric is the largest
@@ -70,6 +71,15 @@ fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
                 .help("Seed of the unstructured meshes"),
         )
         .arg(
+            Arg::new("meshes")
+                .long("meshes")
+                .default_value("1")
+                .value_parser(value_parser!(u64))
+                .help(
+                    "Meshes per round (seeds seed, seed+1, ...), whose results each round averages",
+                ),
+        )
+        .arg(
             Arg::new("max-rounds")
                 .long("max-rounds")
                 .default_value("6")
@@ -88,6 +98,7 @@ fn choose() -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
         mesh_size: f("mesh-size"),
         seed: *args.get_one::<u64>("seed").expect("defaulted"),
         max_rounds: *args.get_one::<usize>("max-rounds").expect("defaulted"),
+        meshes: *args.get_one::<u64>("meshes").expect("defaulted"),
         ..Settings::default()
     };
     run(&common::cli::backend(&args)?, &targets, &settings)
@@ -100,13 +111,14 @@ fn run(
 ) -> Result<Vec<ResultLine>, Box<dyn std::error::Error>> {
     println!("backend: {}", backend.describe());
     println!(
-        "targets: E = {:.3} GPa, nu = {}, UCS = {:.2} MPa, Brazilian tensile strength = {:.2} MPa; meshes {} m, seed {}",
+        "targets: E = {:.3} GPa, nu = {}, UCS = {:.2} MPa, Brazilian tensile strength = {:.2} MPa; meshes {} m, seeds {}-{}",
         targets.young / 1e9,
         targets.poisson,
         targets.ucs / 1e6,
         targets.tensile / 1e6,
         settings.mesh_size,
-        settings.seed
+        settings.seed,
+        settings.seed + settings.meshes.max(1) - 1
     );
     println!(
         "{:>5} {:>10} {:>7} {:>9} {:>8} | {:>9} {:>7} {:>9} {:>8} | {:>7} {:>7} {:>7} {:>7} {:>6}",
@@ -155,7 +167,7 @@ fn run(
     let best = cal.best();
     let e = best.errors(targets);
     println!(
-        "{} after {} virtual tests ({} rounds of a UCS and a Brazilian test) in {:.1} s",
+        "{} after {} virtual tests ({} rounds of a UCS and a Brazilian test on each of {} meshes) in {:.1} s",
         if cal.converged {
             "converged"
         } else {
@@ -163,6 +175,7 @@ fn run(
         },
         cal.virtual_tests,
         cal.rounds.len(),
+        settings.meshes,
         cal.wall_s
     );
     let dir = out_dir("calibrate")?;

@@ -11,7 +11,7 @@
 //! ([`Randomness`]): normal with a coefficient of variation (ξ = 1 + cov · N(0, 1),
 //! redrawn while ξ ≤ 0.01 so no value loses its sign), or Weibull with modulus m (the
 //! classic strength distribution of rock grains: ξ = λ W, W Weibull of shape m and
-//! scale 1, λ = 1 / Γ(1 + 1/m) so that E[ξ] = 1; coefficient of variation about
+//! scale 1, λ = 1 / Γ(1 + 1/m) so that E\[ξ\] = 1; coefficient of variation about
 //! 1.2 / m). A gradient that would make a value non-positive inside the points is an
 //! error naming the point.
 //!

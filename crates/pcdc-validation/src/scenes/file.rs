@@ -30,6 +30,8 @@ const SCENES: &str = "\"ucs\" or \"brazilian\"";
 
 /// A parsed and validated scene file.
 #[derive(Clone, Debug, PartialEq)]
+// Parsed once per run: boxing the larger variant would only burden every match.
+#[allow(clippy::large_enum_variant)]
 pub enum SceneFile {
     /// `scene = "ucs"`.
     Ucs(ucs::Params),
