@@ -240,7 +240,7 @@ pub fn jobs(case: &str, gpu: bool) -> Vec<Job> {
         // are the examples: about 2 and 1 minutes on 2 idle cores).
         "ucs" => {
             for size in [0.006, 0.005, 0.004] {
-                out.push(j("ucs", "E vs input; UCS/Ts", size));
+                out.push(j("ucs", "E vs target; UCS/Ts", size));
             }
         }
         "brazilian" => {
@@ -738,7 +738,7 @@ pub fn markdown(rows: &[Row], machine: &str) -> String {
         "Error: the scene's measure (kirsch: max error / max |σθ|; wave_speed: wave speed; \
          vibration_energy: energy drift; block_sliding: stopping distance; direct_tension: \
          peak neck stress against Ts, signed; ucs: Young's modulus from 20–50 % of the \
-         peak against the input E, with UCS/Ts in the tolerance column; brazilian: \
+         peak against the target E (calibrated elements, unstructured mesh), with UCS/Ts in the tolerance column; brazilian: \
          2P/(πD) / Ts − 1; radial_flow: largest |p − p_exact| / (p_i − p_o) over every flow \
          node, its elements column counting flow channels; fracture_flow: largest \
          |p − p_exact| / p_A at x = L/2 and L, \
