@@ -257,6 +257,23 @@ fn bad_domains_and_options_are_named() {
         ..MesherOptions::uniform(0.1)
     };
     assert!(domain_error(&sq, &graded).contains("graded"));
+    // A very wide gradation is refused before it allocates the sampler's grid.
+    let holed = Domain::new(Loop::new(vec![
+        [0.0, 0.0],
+        [100.0, 0.0],
+        [100.0, 100.0],
+        [0.0, 100.0],
+    ]))
+    .hole(Loop::circle([50.0, 50.0], 1.0, 16));
+    let wide = MesherOptions {
+        size: SizeField::Graded {
+            near: 0.011,
+            far: 5.0,
+            growth: 0.5,
+        },
+        ..MesherOptions::uniform(1.0)
+    };
+    assert!(domain_error(&holed, &wide).contains("64 million"));
     // Serde input goes through the same checks.
     let d: Domain =
         serde_json::from_str(r#"{"outer": {"points": [[0,0],[1,1],[1,0],[0,1]]}}"#).unwrap();

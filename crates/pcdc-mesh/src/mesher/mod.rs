@@ -327,6 +327,15 @@ pub fn triangulate(domain: &Domain, options: &MesherOptions) -> Result<Mesh<Dim2
             reason: "a graded size grows from the holes and lines, and the domain has none",
         });
     }
+    // The sampler's grid spans the bounding box at the finest size: a wide gradation
+    // (a tiny `near` in a large domain) must not allocate gigabytes for it.
+    if sampling::grid_cells(lo, hi, h_min) > 6.4e7 {
+        return Err(MeshError::InvalidParameter {
+            name: "near",
+            value: h_min,
+            reason: "is too small for the domain's extent: the sampler's grid would exceed 64 million cells (about 256 MB); use a larger finest size or mesh a smaller domain",
+        });
+    }
     let inside = Inside::new(&segs);
     let size = Size::new(&options.size, lo, hi, &features);
     check_count(domain, &size, h_min, lo, hi, &inside)?;

@@ -50,9 +50,11 @@ impl Size {
                 grid: Vec::new(),
             },
             SizeField::Graded { near, far, growth } => {
-                // Grid spacing of half the finest size: the field is linear in the
-                // distance, so bilinear interpolation errs by a fraction of `near`.
-                let cell = 0.5 * near;
+                // Grid spacing of half the finest size (the field is linear in the
+                // distance, so bilinear interpolation errs by a fraction of `near`), but
+                // at most 2000 × 2000 nodes for a very wide gradation.
+                let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+                let cell = (0.5 * near).max(extent / 2000.0);
                 let nx = (((hi[0] - lo[0]) / cell).ceil() as usize).max(1);
                 let ny = (((hi[1] - lo[1]) / cell).ceil() as usize).max(1);
                 let mut grid = Vec::with_capacity((nx + 1) * (ny + 1));
@@ -128,6 +130,13 @@ pub(super) fn subdivide(a: [f64; 2], b: [f64; 2], size: &Size) -> Vec<[f64; 2]> 
         out.push(at(t));
     }
     out
+}
+
+/// Cells of the sampler's background grid for the bounding box `lo`–`hi` and the
+/// smallest size `h_min` (one cell of side 0.74 h_min / √2 per possible sample).
+pub(super) fn grid_cells(lo: [f64; 2], hi: [f64; 2], h_min: f64) -> f64 {
+    let cell = DISK_RADIUS * h_min / std::f64::consts::SQRT_2;
+    ((hi[0] - lo[0]) / cell).ceil().max(1.0) * ((hi[1] - lo[1]) / cell).ceil().max(1.0)
 }
 
 /// A Poisson-disk sample of the domain's interior (Bridson's algorithm with a radius
