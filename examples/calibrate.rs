@@ -118,7 +118,7 @@ fn run(
         targets.tensile / 1e6,
         settings.mesh_size,
         settings.seed,
-        settings.seed + settings.meshes.max(1) - 1
+        settings.seed.saturating_add(settings.meshes.max(1) - 1)
     );
     println!(
         "{:>5} {:>10} {:>7} {:>9} {:>8} | {:>9} {:>7} {:>9} {:>8} | {:>7} {:>7} {:>7} {:>7} {:>6}",

@@ -49,7 +49,7 @@ fn finite(name: &'static str, v: f64) -> Result<f64, MeshError> {
     }
 }
 
-fn positive(name: &'static str, v: f64) -> Result<f64, MeshError> {
+pub(crate) fn positive(name: &'static str, v: f64) -> Result<f64, MeshError> {
     if finite(name, v)? > 0.0 {
         Ok(v)
     } else {

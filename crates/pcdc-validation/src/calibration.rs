@@ -320,7 +320,7 @@ impl Calibration {
              [joints]\nfriction_deg = {}\ncohesion = {:.6e}\ntensile_strength = {:.6e}\ngf1 = {}\ngf2 = {}\n\
              penalty_normal = {}\npenalty_shear = {}\npenalty_overlap = {}\n",
             t.young, t.poisson, t.ucs, t.tensile,
-            self.settings.mesh_size, self.settings.seed, self.settings.seed + self.settings.meshes - 1,
+            self.settings.mesh_size, self.settings.seed, self.settings.seed.saturating_add(self.settings.meshes.max(1) - 1),
             r.young, r.poisson, r.ucs, r.tensile,
             r.rock.young, r.rock.poisson, r.rock.density, r.rock.damping,
             j.friction_deg, j.cohesion, j.tensile_strength, j.gf1, j.gf2,
@@ -400,8 +400,8 @@ pub fn calibrate(
         // The mean over the round's meshes of E, ν, UCS and σt.
         let mut sum = [0.0; 4];
         for k in 0..settings.meshes {
-            pu.sample.seed = settings.seed + k;
-            pb.disc.seed = settings.seed + k;
+            pu.sample.seed = settings.seed.wrapping_add(k);
+            pb.disc.seed = settings.seed.wrapping_add(k);
             let u = ucs::run(backend, &pu, &mut |_| {})?;
             let b = brazilian::run(backend, &pb, &mut |_| {})?;
             // The sample's E from its plane-strain slope with its own ν.

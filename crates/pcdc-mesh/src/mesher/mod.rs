@@ -338,7 +338,7 @@ pub fn triangulate(domain: &Domain, options: &MesherOptions) -> Result<Mesh<Dim2
     }
     let inside = Inside::new(&segs);
     let size = Size::new(&options.size, lo, hi, &features);
-    check_count(domain, &size, h_min, lo, hi, &inside)?;
+    check_count(&size, h_min, lo, hi, &inside)?;
 
     // 1. Loops and lines, divided; constraint edges between consecutive points.
     let mut pts: Vec<[f64; 2]> = Vec::new();
@@ -390,7 +390,6 @@ pub fn triangulate(domain: &Domain, options: &MesherOptions) -> Result<Mesh<Dim2
 
 /// The memory and index-width guard, from the expected element count ∫ dA / A(h).
 fn check_count(
-    _domain: &Domain,
     size: &Size,
     h_min: f64,
     lo: [f64; 2],

@@ -4,19 +4,8 @@
 use std::f64::consts::TAU;
 
 use super::{triangulate, Domain, Loop, MesherOptions, SizeField};
+use crate::builders::positive;
 use crate::{Dim2, Mesh, MeshError};
-
-fn positive(name: &'static str, v: f64) -> Result<f64, MeshError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(MeshError::InvalidParameter {
-            name,
-            value: v,
-            reason: "must be finite and positive",
-        })
-    }
-}
 
 /// Points on a circle of radius `r` about `c` (m), about `h` apart (at least 8).
 fn circle(c: [f64; 2], r: f64, h: f64) -> Vec<[f64; 2]> {
