@@ -57,6 +57,15 @@ fn run(
         p.sample.joints.tensile_strength / 1e6,
         p.response_time
     );
+    match &p.membrane {
+        Some(m) => println!(
+            "walls: {} per side, behind membranes {} mm thick, E = {} GPa",
+            p.segments,
+            1e3 * m.thickness,
+            m.young / 1e9
+        ),
+        None => println!("walls: {} per side, on the rock", p.segments),
+    }
     println!(
         "{:>10} {:>12} {:>16} {:>8} {:>18} {:>14} {:>8} {:>8}",
         "sigma3 MPa",

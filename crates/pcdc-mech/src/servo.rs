@@ -146,6 +146,11 @@ impl StressServo {
         self.kp / self.ki / 2.0
     }
 
+    /// The loaded length (m, 2D per unit thickness) or area (m², 3D).
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+
     /// The nodes.
     pub fn nodes(&self) -> &[u32] {
         &self.nodes
