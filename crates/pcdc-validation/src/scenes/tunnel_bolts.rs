@@ -24,7 +24,7 @@ use pcdc_cohesive::{CohesiveJoints, IntrinsicCzmParams, BROKEN_FACE, JOINT_DAMAG
 use pcdc_compute::{Backend, Simulation, Table};
 use pcdc_contact::Contact;
 use pcdc_mech::{Boundary, FaceStress, LinearElastic, Mechanics};
-use pcdc_mesh::{split_nodes, Range};
+use pcdc_mesh::{split_nodes, Dim2, Range};
 
 use crate::report::SceneError;
 use crate::scenes::kirsch;
@@ -84,15 +84,17 @@ pub struct Outcome {
     pub wall_s: f64,
 }
 
-fn bolt_pattern() -> Result<Bolts, SceneError> {
+/// `n` radial bolts evenly around the wall (25 mm rebar, [`BOLT_LENGTH`] from the wall,
+/// 10 segments, face plates, rows 1 m apart out of plane); the scene uses [`BOLTS`].
+pub fn bolt_pattern(n: usize) -> Result<Bolts, SceneError> {
     let rebar = BoltMaterial::new(BoltProperties {
         spacing: Some(1.0),
         ..BoltProperties::steel_rebar(0.025)
     })?;
     let mut bolts = Bolts::new();
-    for i in 0..BOLTS {
+    for i in 0..n {
         // Offset from the axes so that no bolt lies on the supports' symmetry lines.
-        let a = 2.0 * std::f64::consts::PI * (i as f64 + 0.5) / BOLTS as f64;
+        let a = 2.0 * std::f64::consts::PI * (i as f64 + 0.5) / n as f64;
         let (c, s) = (a.cos(), a.sin());
         let r1 = RADIUS + BOLT_LENGTH;
         bolts = bolts.bolt(
@@ -109,16 +111,19 @@ fn bolt_pattern() -> Result<Bolts, SceneError> {
     Ok(bolts)
 }
 
-/// Runs the scene once.
-pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
-    let start = Instant::now();
+/// The scene's simulation at element size `size` (m) at the wall, with `bolts` if
+/// given (e.g. [`bolt_pattern`]); also used by the `bolted_tunnel` bench.
+pub fn simulation(
+    backend: &Backend,
+    size: f64,
+    bolts: Option<Bolts>,
+) -> Result<Simulation<Dim2>, SceneError> {
     let mesh = kirsch::mesh(&kirsch::Params {
         radius: RADIUS,
-        size_at_hole: p.size / RADIUS,
+        size_at_hole: size / RADIUS,
         vtu_dir: None,
         element: crate::scenes::Element::Simplex,
     })?;
-    let elements = mesh.n_elements();
     let mesh = split_nodes(
         &mesh,
         &Range::Ball {
@@ -126,7 +131,6 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
             radius: JOINTED,
         },
     )?;
-    let joints = mesh.interfaces().len();
     let rock = LinearElastic::new(YOUNG, 0.25, 2600.0)?;
     let joint = IntrinsicCzmParams {
         friction_deg: 30.0,
@@ -158,14 +162,23 @@ pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
                 .face_stress(Range::group("inner"), FaceStress::normal(wall_pressure)),
         ))
         .local_damping(0.5);
+    if let Some(bolts) = bolts {
+        builder = builder.physics(bolts);
+    }
+    Ok(builder.build()?)
+}
+
+/// Runs the scene once.
+pub fn run(backend: &Backend, p: &Params) -> Result<Outcome, SceneError> {
+    let start = Instant::now();
     let layout = if p.bolted {
-        let bolts = bolt_pattern()?;
-        builder = builder.physics(bolts.clone());
-        Some(bolts)
+        Some(bolt_pattern(BOLTS)?)
     } else {
         None
     };
-    let mut sim = builder.build()?;
+    let mut sim = simulation(backend, p.size, layout.clone())?;
+    let elements = sim.mesh().n_elements();
+    let joints = sim.mesh().interfaces().len();
     let mut bolt_max: f64 = 0.0;
     let t_end = RELEASE + HOLD;
     let chunks = 40;
