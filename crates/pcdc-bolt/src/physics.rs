@@ -437,6 +437,70 @@ impl NodePass<'_> {
     }
 }
 
+impl Bolts {
+    /// The segment pass, then the node pass (see `compute_forces`).
+    fn passes<D: Dim>(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+        let d = D::D;
+        let ids = self.ids.expect("init ran");
+        let kin = &ctx.kin;
+        // Segments: axial force (total form) plus damping on the relative velocity. Each
+        // segment and each node writes only its own entries: parallel and deterministic.
+        {
+            let [axial, plastic, state] =
+                ctx.fields.get_many_mut([ids.axial, ids.plastic, ids.state]);
+            self.segments
+                .par_iter()
+                .zip(
+                    self.seg_force
+                        .par_iter_mut()
+                        .zip(self.seg_dir.par_iter_mut()),
+                )
+                .zip(axial.par_iter_mut())
+                .zip(plastic.par_iter_mut().zip(state.par_iter_mut()))
+                .with_min_len(MIN_LEN)
+                .for_each(|(((seg, (force, dir)), axial), (plastic, state))| {
+                    let (e, elongation) = segment_state(seg, kin);
+                    *dir = e;
+                    let broken = SegmentState::from_value(*state) == SegmentState::Broken;
+                    let (f, up, st) = seg.law.update(elongation, seg.l0, *plastic, broken);
+                    *axial = f;
+                    *plastic = up;
+                    *state = st as i32 as f64;
+                    let mut total = f;
+                    if seg.damping > 0.0 && st != SegmentState::Broken {
+                        let (a, b) = (seg.n[0] as usize * d, seg.n[1] as usize * d);
+                        let rel: f64 = (0..d).map(|k| (kin.v[b + k] - kin.v[a + k]) * e[k]).sum();
+                        total += seg.damping * rel;
+                    }
+                    *force = [total * e[0], total * e[1], total * e[2]];
+                });
+        }
+        // Nodes: the host's stress (and rotation in 3D) are read in place.
+        let (grout, slip, stress, rotation) = if let Some(r) = ids.rotation {
+            let [g, s, st, rot] = ctx
+                .fields
+                .get_many_mut([ids.grout, ids.slip, ids.stress, r]);
+            (g, s, &*st, &*rot)
+        } else {
+            let [g, s, st] = ctx.fields.get_many_mut([ids.grout, ids.slip, ids.stress]);
+            (g, s, &*st, &[][..])
+        };
+        let pass = NodePass {
+            seg_dir: &self.seg_dir,
+            seg_force: &self.seg_force,
+            stress,
+            rotation,
+        };
+        ctx.slots
+            .par_chunks_mut((d + 2) * d)
+            .zip(self.nodes.par_iter())
+            .zip(grout.par_iter_mut().zip(slip.par_iter_mut()))
+            .with_min_len(MIN_LEN)
+            .for_each(|((slots, n), (grout, slip))| pass.node(n, kin, slots, grout, slip));
+        Ok(())
+    }
+}
+
 impl<D: Dim> Physics<D> for Bolts {
     fn name(&self) -> &str {
         NAME
@@ -599,71 +663,10 @@ impl<D: Dim> Physics<D> for Bolts {
     }
 
     fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
-        let d = D::D;
-        let ids = self.ids.expect("init ran");
-        let kin = &ctx.kin;
-        // Segments: axial force (total form) plus damping on the relative velocity. Each
-        // segment and each node writes only its own entries: parallel and deterministic.
-        // Both passes run on the backend's pool (its thread count), not on rayon's
-        // global pool, like the other physics.
+        // Both passes on the backend's pool (its thread count; a parallel iterator
+        // outside it runs on rayon's global pool), entered once per step.
         let backend = ctx.backend;
-        {
-            let [axial, plastic, state] =
-                ctx.fields.get_many_mut([ids.axial, ids.plastic, ids.state]);
-            let (segments, seg_force, seg_dir) =
-                (&self.segments, &mut self.seg_force, &mut self.seg_dir);
-            backend.install(|| {
-                segments
-                    .par_iter()
-                    .zip(seg_force.par_iter_mut().zip(seg_dir.par_iter_mut()))
-                    .zip(axial.par_iter_mut())
-                    .zip(plastic.par_iter_mut().zip(state.par_iter_mut()))
-                    .with_min_len(MIN_LEN)
-                    .for_each(|(((seg, (force, dir)), axial), (plastic, state))| {
-                        let (e, elongation) = segment_state(seg, kin);
-                        *dir = e;
-                        let broken = SegmentState::from_value(*state) == SegmentState::Broken;
-                        let (f, up, st) = seg.law.update(elongation, seg.l0, *plastic, broken);
-                        *axial = f;
-                        *plastic = up;
-                        *state = st as i32 as f64;
-                        let mut total = f;
-                        if seg.damping > 0.0 && st != SegmentState::Broken {
-                            let (a, b) = (seg.n[0] as usize * d, seg.n[1] as usize * d);
-                            let rel: f64 =
-                                (0..d).map(|k| (kin.v[b + k] - kin.v[a + k]) * e[k]).sum();
-                            total += seg.damping * rel;
-                        }
-                        *force = [total * e[0], total * e[1], total * e[2]];
-                    })
-            });
-        }
-        // Nodes: the host's stress (and rotation in 3D) are read in place.
-        let (grout, slip, stress, rotation) = if let Some(r) = ids.rotation {
-            let [g, s, st, rot] = ctx
-                .fields
-                .get_many_mut([ids.grout, ids.slip, ids.stress, r]);
-            (g, s, &*st, &*rot)
-        } else {
-            let [g, s, st] = ctx.fields.get_many_mut([ids.grout, ids.slip, ids.stress]);
-            (g, s, &*st, &[][..])
-        };
-        let pass = NodePass {
-            seg_dir: &self.seg_dir,
-            seg_force: &self.seg_force,
-            stress,
-            rotation,
-        };
-        let (slots, nodes) = (&mut *ctx.slots, &self.nodes);
-        backend.install(|| {
-            slots
-                .par_chunks_mut((d + 2) * d)
-                .zip(nodes.par_iter())
-                .zip(grout.par_iter_mut().zip(slip.par_iter_mut()))
-                .with_min_len(MIN_LEN)
-                .for_each(|((slots, n), (grout, slip))| pass.node(n, kin, slots, grout, slip))
-        });
-        Ok(())
+        backend.install(|| self.passes(ctx))
     }
 
     fn stored_energy(&self, kin: &Kinematics<'_, D>, fields: &FieldStore) -> f64 {
