@@ -160,3 +160,44 @@ fn scene_tag_is_required_and_checked() {
     let msg = error("scene = \"ucs\"\n[sample\n");
     assert!(msg.contains("line 2"), "{msg}");
 }
+
+/// A confinement survives the round trip with and without its membrane (`None` is
+/// written as `membrane = "none"`: TOML has no null, and an absent key means the
+/// default membrane); another word is an error that names the key.
+#[test]
+fn confinement_membrane_round_trips_and_none_is_a_word() {
+    use pcdc_validation::scenes::platen_test::{Confinement, Membrane};
+    let c = Confinement {
+        stress: 5e6,
+        response_time: 2.5e-5,
+        max_speed: 1.0,
+        tolerance: 0.005,
+        segments: 1,
+        membrane: Some(Membrane {
+            thickness: 0.004,
+            ..Membrane::default()
+        }),
+    };
+    for membrane in [c.membrane, None] {
+        let mut u = ucs::Params::default();
+        u.confinement = Some(Confinement {
+            membrane,
+            ..c.clone()
+        });
+        let scene = SceneFile::Ucs(u);
+        let text = scene.to_toml().unwrap();
+        assert_eq!(SceneFile::from_toml(&text).unwrap(), scene, "{text}");
+        if membrane.is_none() {
+            assert!(text.contains("membrane = \"none\""), "{text}");
+        }
+    }
+    let head = "scene = \"ucs\"\n[confinement]\nstress = 5e6\nresponse_time = 2.5e-5\nmax_speed = 1.0\ntolerance = 0.005\n";
+    match SceneFile::from_toml(head).unwrap() {
+        SceneFile::Ucs(u) => {
+            assert_eq!(u.confinement.unwrap().membrane, Some(Membrane::default()))
+        }
+        other => panic!("{other:?}"),
+    }
+    let msg = error(&format!("{head}membrane = \"off\"\n"));
+    assert!(msg.contains("membrane"), "{msg}");
+}

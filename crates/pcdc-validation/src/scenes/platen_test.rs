@@ -464,13 +464,45 @@ pub struct Confinement {
     #[serde(default = "default_segments")]
     pub segments: u32,
     /// A soft membrane between each servo wall and the specimen's side (the rubber
-    /// sleeve of a laboratory cell), `None` for walls on the specimen's own nodes.
-    #[serde(default = "default_membrane")]
+    /// sleeve of a laboratory cell), `None` for walls on the specimen's own nodes. In
+    /// a scene file: a `[confinement.membrane]` table (the default when absent), or
+    /// `membrane = "none"` (TOML has no null, and an absent key means the default).
+    #[serde(default = "default_membrane", with = "membrane_or_none")]
     pub membrane: Option<Membrane>,
 }
 
 fn default_membrane() -> Option<Membrane> {
     Some(Membrane::default())
+}
+
+/// [`Confinement::membrane`] in scene files: a table, or the string `"none"`.
+mod membrane_or_none {
+    use super::Membrane;
+    use serde::{de, Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize, Deserialize)]
+    #[serde(untagged)]
+    enum Form {
+        Word(String),
+        Table(Membrane),
+    }
+
+    pub fn serialize<S: Serializer>(m: &Option<Membrane>, s: S) -> Result<S::Ok, S::Error> {
+        match m {
+            Some(m) => Form::Table(*m).serialize(s),
+            None => Form::Word("none".into()).serialize(s),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Membrane>, D::Error> {
+        match Form::deserialize(d)? {
+            Form::Table(m) => Ok(Some(m)),
+            Form::Word(w) if w == "none" => Ok(None),
+            Form::Word(w) => Err(de::Error::custom(format!(
+                "confinement.membrane: \"{w}\" is neither a membrane table nor \"none\""
+            ))),
+        }
+    }
 }
 
 /// The membrane of a servo-confined test: an elastic strip of `thickness` along each
