@@ -6,7 +6,7 @@
 
 use pcdc_compute::{Backend, Simulation};
 use pcdc_mech::{Boundary, LinearElastic, Mechanics, ServoGains, StressServo};
-use pcdc_mesh::{builders, Dim3, Range};
+use pcdc_mesh::{builders, Dim3, Mesh, Range};
 
 const SIDE: f64 = 0.02;
 const YOUNG: f64 = 30e9;
@@ -19,8 +19,8 @@ const SIGMA_Y: f64 = 5e6;
 /// One record window: mean strains (x, y, z) and the platen's mean stress (Pa).
 type Row = ([f64; 3], f64);
 
-fn face_nodes(sim: &Simulation<Dim3>, group: &str) -> Vec<u32> {
-    sim.mesh().groups().nodes[group].clone()
+fn face_nodes(mesh: &Mesh<Dim3>, group: &str) -> Vec<u32> {
+    mesh.groups().nodes[group].clone()
 }
 
 fn mean(sim: &Simulation<Dim3>, nodes: &[u32], axis: usize) -> f64 {
@@ -43,10 +43,9 @@ fn true_triaxial_servo_walls_hold_two_stresses_and_match_the_closed_form() {
     // Response: about four P-wave transits of the cube.
     let tau = 4.0 * SIDE / (m / DENSITY).sqrt();
     let gains = ServoGains::for_specimen(m, SIDE, tau, z);
-    let nodes = |g: &str| mesh.groups().nodes[g].clone();
     let area = SIDE * SIDE;
     let servo = |g: &str, axis, inward, target| {
-        StressServo::new(nodes(g), axis, inward, area, target, gains, 1.0).unwrap()
+        StressServo::new(face_nodes(&mesh, g), axis, inward, area, target, gains, 1.0).unwrap()
     };
     let mut walls = [
         servo("xmin", 0, 1.0, SIGMA_X),
@@ -108,9 +107,18 @@ fn true_triaxial_servo_walls_hold_two_stresses_and_match_the_closed_form() {
         }
     }
     assert!(consolidated, "the walls did not reach their stresses");
-    let (zmax, zmin) = (face_nodes(&sim, "zmax"), face_nodes(&sim, "zmin"));
-    let (xmin, xmax) = (face_nodes(&sim, "xmin"), face_nodes(&sim, "xmax"));
-    let (ymin, ymax) = (face_nodes(&sim, "ymin"), face_nodes(&sim, "ymax"));
+    let (zmax, zmin) = (
+        face_nodes(sim.mesh(), "zmax"),
+        face_nodes(sim.mesh(), "zmin"),
+    );
+    let (xmin, xmax) = (
+        face_nodes(sim.mesh(), "xmin"),
+        face_nodes(sim.mesh(), "xmax"),
+    );
+    let (ymin, ymax) = (
+        face_nodes(sim.mesh(), "ymin"),
+        face_nodes(sim.mesh(), "ymax"),
+    );
     let strains = |sim: &Simulation<Dim3>| {
         [
             (mean(sim, &xmax, 0) - mean(sim, &xmin, 0)) / SIDE,

@@ -1059,12 +1059,12 @@ pub(crate) fn run(
     let frame_every = (max_steps / u64::from(s.output.frames.max(1))).max(every);
     let mut next_frame = frame_every;
     let chunk = reaction_chunk(backend.kind(), every);
-    let mean_y = |sim: &Simulation<Dim2>, list: &[u32]| {
-        list.iter()
-            .map(|&n| sim.state.u[2 * n as usize + 1])
-            .sum::<f64>()
-            / list.len().max(1) as f64
-    };
+    let mean_y = |sim: &Simulation<Dim2>, list: &[u32]| mean_of(&sim.state.u, list, 1);
+    // Weight of one reaction read in the feed-forward's running mean of the strain rate
+    // (time constant a fifth of the servo's response time).
+    let rate_weight = s.confinement.map_or(1.0, |c| {
+        (chunk as f64 * dt / (0.2 * c.response_time)).min(1.0)
+    });
     let mut samples = Vec::new();
     let (mut acc, mut count) = (0.0, 0u64);
     let (mut peak, mut peak_index) = (0.0f64, 0usize);
@@ -1104,16 +1104,9 @@ pub(crate) fn run(
                 // start, and walls fed from the platens' speed retreat too early
                 // (measured: −1.8 % of σ3 at the start of the loading). Smoothed over
                 // the servo's response time against the end nodes' vibration.
-                let mean_vy = |list: &[u32]| {
-                    list.iter()
-                        .map(|&n| sim.state.v[2 * n as usize + 1])
-                        .sum::<f64>()
-                        / list.len().max(1) as f64
-                };
-                let rate = (mean_vy(&spec_bottom) - mean_vy(&spec_top)) / height;
-                let c = s.confinement.expect("servos come with a confinement");
-                let w = (chunk as f64 * dt / (0.2 * c.response_time)).min(1.0);
-                strain_rate += w * (rate - strain_rate);
+                let v = &sim.state.v;
+                let rate = (mean_of(v, &spec_bottom, 1) - mean_of(v, &spec_top, 1)) / height;
+                strain_rate += rate_weight * (rate - strain_rate);
                 let nu = s.rock.poisson;
                 let expansion = nu / (1.0 - nu) * strain_rate.max(0.0) * 0.5 * width;
                 for (_, servo) in &mut servos.sides {
@@ -1148,13 +1141,8 @@ pub(crate) fn run(
                     mean_y(&sim, &spec_bottom) - mean_y(&sim, &spec_top),
                     0.0,
                 ];
-                let mean_x = |list: &[u32]| {
-                    list.iter()
-                        .map(|&n| sim.state.u[2 * n as usize])
-                        .sum::<f64>()
-                        / list.len().max(1) as f64
-                };
-                base[2] = mean_x(&spec_right) - mean_x(&spec_left);
+                let u = &sim.state.u;
+                base[2] = mean_of(u, &spec_right, 0) - mean_of(u, &spec_left, 0);
             } else if sim.state.time > t_consolidate {
                 return Err(SceneError::Measurement(format!(
                     "biaxial consolidation: the servo walls did not hold {:.3e} Pa within {:.1} % after {:.3e} s (stresses {means:?} Pa); raise confinement.response_time",
@@ -1182,22 +1170,12 @@ pub(crate) fn run(
             wall_acc.fill(0.0);
             let closure = mean_y(&sim, &loaded_bottom) - mean_y(&sim, &loaded_top) - base[0];
             let shortening = mean_y(&sim, &spec_bottom) - mean_y(&sim, &spec_top) - base[1];
-            let mean_x = |list: &[u32]| {
-                list.iter()
-                    .map(|&n| sim.state.u[2 * n as usize])
-                    .sum::<f64>()
-                    / list.len().max(1) as f64
-            };
-            let widening = mean_x(&spec_right) - mean_x(&spec_left) - base[2];
+            let u = &sim.state.u;
+            let widening = mean_of(u, &spec_right, 0) - mean_of(u, &spec_left, 0) - base[2];
             // Kinetic energy of the specimen relative to the uniform compression between
             // the platens' current velocities (the motion a quasi-static test has).
-            let mean_vy = |list: &[u32]| {
-                list.iter()
-                    .map(|&n| sim.state.v[2 * n as usize + 1])
-                    .sum::<f64>()
-                    / list.len().max(1) as f64
-            };
-            let (vb, vt) = (mean_vy(&loaded_bottom), mean_vy(&loaded_top));
+            let v = &sim.state.v;
+            let (vb, vt) = (mean_of(v, &loaded_bottom, 1), mean_of(v, &loaded_top, 1));
             let mass = sim.mass();
             let kinetic = 0.5
                 * spec_nodes
@@ -1441,6 +1419,14 @@ impl From<ParamError> for SceneError {
     fn from(e: ParamError) -> Self {
         SceneError::Compute(pcdc_compute::ComputeError::param(e.key, e.value, e.reason))
     }
+}
+
+/// Mean of component `k` of the 2D vectors `values` (u or v) over the nodes `list`.
+fn mean_of(values: &[f64], list: &[u32], k: usize) -> f64 {
+    list.iter()
+        .map(|&n| values[2 * n as usize + k])
+        .sum::<f64>()
+        / list.len().max(1) as f64
 }
 
 /// The servo walls of a biaxial test: the side segments (group name, servo) and the two
