@@ -179,12 +179,13 @@ fn confinement_membrane_round_trips_and_none_is_a_word() {
         }),
     };
     for membrane in [c.membrane, None] {
-        let mut u = ucs::Params::default();
-        u.confinement = Some(Confinement {
-            membrane,
-            ..c.clone()
+        let scene = SceneFile::Ucs(ucs::Params {
+            confinement: Some(Confinement {
+                membrane,
+                ..c.clone()
+            }),
+            ..ucs::Params::default()
         });
-        let scene = SceneFile::Ucs(u);
         let text = scene.to_toml().unwrap();
         assert_eq!(SceneFile::from_toml(&text).unwrap(), scene, "{text}");
         if membrane.is_none() {
