@@ -201,4 +201,7 @@ fn confinement_membrane_round_trips_and_none_is_a_word() {
     }
     let msg = error(&format!("{head}membrane = \"off\"\n"));
     assert!(msg.contains("membrane"), "{msg}");
+    // A misspelt key inside the table is named.
+    let msg = error(&format!("{head}[confinement.membrane]\nthicknes = 0.004\n"));
+    assert!(msg.contains("thicknes"), "{msg}");
 }

@@ -478,30 +478,44 @@ fn default_membrane() -> Option<Membrane> {
 /// [`Confinement::membrane`] in scene files: a table, or the string `"none"`.
 mod membrane_or_none {
     use super::Membrane;
-    use serde::{de, Deserialize, Deserializer, Serialize, Serializer};
-
-    #[derive(Serialize, Deserialize)]
-    #[serde(untagged)]
-    enum Form {
-        Word(String),
-        Table(Membrane),
-    }
+    use serde::de::{self, MapAccess, Visitor};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
     pub fn serialize<S: Serializer>(m: &Option<Membrane>, s: S) -> Result<S::Ok, S::Error> {
         match m {
-            Some(m) => Form::Table(*m).serialize(s),
-            None => Form::Word("none".into()).serialize(s),
+            Some(m) => m.serialize(s),
+            None => s.serialize_str("none"),
+        }
+    }
+
+    /// A visitor rather than an untagged enum, so that a bad key inside the table is
+    /// named by the membrane's own error.
+    struct Form;
+
+    impl<'de> Visitor<'de> for Form {
+        type Value = Option<Membrane>;
+
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a membrane table or \"none\"")
+        }
+
+        fn visit_str<E: de::Error>(self, w: &str) -> Result<Self::Value, E> {
+            if w == "none" {
+                Ok(None)
+            } else {
+                Err(E::custom(format!(
+                    "confinement.membrane: \"{w}\" is neither a membrane table nor \"none\""
+                )))
+            }
+        }
+
+        fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+            Membrane::deserialize(de::value::MapAccessDeserializer::new(map)).map(Some)
         }
     }
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Membrane>, D::Error> {
-        match Form::deserialize(d)? {
-            Form::Table(m) => Ok(Some(m)),
-            Form::Word(w) if w == "none" => Ok(None),
-            Form::Word(w) => Err(de::Error::custom(format!(
-                "confinement.membrane: \"{w}\" is neither a membrane table nor \"none\""
-            ))),
-        }
+        d.deserialize_any(Form)
     }
 }
 
