@@ -36,12 +36,19 @@ pub(crate) struct BoltNode {
     pub host: u32,
     pub host_nodes: [u32; 4],
     pub weights: [f64; 4],
+    /// 2D: the adjugate of the host's reference edge matrix D_m (dm3, −dm1, −dm2, dm0),
+    /// so that D_x adj(D_m) = det(D_m) F gives the host's rotation without a division.
+    pub ref_adj: [f64; 4],
     /// K_b,r,s l (N/m), 0 on the free length.
     pub k_axial: f64,
     /// Lateral grout stiffness × l (N/m).
     pub k_normal: f64,
     /// Tributary length over the spacing (m): bond capacity = S_b(σn) × this.
     pub bond_length: f64,
+    /// The bond capacity without confinement, S_b(0) × `bond_length` (N): the capacity
+    /// never falls below it (S_b grows with σn ≥ 0), so a grout force within it is
+    /// elastic whatever the confinement, and the host's stress need not be read.
+    pub cap_unconfined: f64,
     /// Bond constants (eq. 146-147): π (D_b + 2 T_g), C_r,g, tan φ_r,g, π D_b, C_b,g,
     /// tan φ_b,g.
     pub bond: [f64; 6],
@@ -74,9 +81,11 @@ pub struct Bolts {
     node_offset: Vec<usize>,
     segment_offset: Vec<usize>,
     ids: Option<Ids>,
-    /// Work buffers: segment force vectors and current unit directions.
-    seg_force: Vec<[f64; 3]>,
-    seg_dir: Vec<[f64; 3]>,
+    /// Work blocks of whole bolts (first node and first segment of each; see
+    /// [`blocks`]): the unit of parallel work.
+    blocks: Vec<(usize, usize)>,
+    /// [`PARALLEL_FROM`] and [`BLOCK_NODES`] (tests vary them).
+    blocking: (usize, usize),
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -106,8 +115,8 @@ impl Bolts {
             node_offset: Vec::new(),
             segment_offset: Vec::new(),
             ids: None,
-            seg_force: Vec::new(),
-            seg_dir: Vec::new(),
+            blocks: Vec::new(),
+            blocking: (PARALLEL_FROM, BLOCK_NODES),
         }
     }
 
@@ -220,16 +229,27 @@ impl Bolts {
                         })?;
                 let mut host_nodes = [0u32; 4];
                 host_nodes[..=d].copy_from_slice(mesh.element(host.element));
+                let mut ref_adj = [0.0; 4];
+                if two_d {
+                    let x = |q: usize| mesh.node(host_nodes[q] as usize);
+                    let (x0, x1, x2) = (x(0), x(1), x(2));
+                    let dm = [x1[0] - x0[0], x2[0] - x0[0], x1[1] - x0[1], x2[1] - x0[1]];
+                    ref_adj = [dm[3], -dm[1], -dm[2], dm[0]];
+                }
+                let bond = bolt.material().bond_constants();
                 self.nodes.push(BoltNode {
                     node: node + k as u32,
                     bolt: b as u32,
                     host: host.element as u32,
                     host_nodes,
                     weights: host.weights,
+                    ref_adj,
                     k_axial: if grouted { eff.shear * l } else { 0.0 },
                     k_normal: eff.normal * l,
                     bond_length: l * eff.bond_per_spacing,
-                    bond: bolt.material().bond_constants(),
+                    cap_unconfined: crate::material::bond_strength(&bond, 0.0)
+                        * (l * eff.bond_per_spacing),
+                    bond,
                     prev: if k > 0 { seg0 + k as u32 - 1 } else { NONE },
                     next: if k + 1 < n { seg0 + k as u32 } else { NONE },
                     plate: if k == 0 {
@@ -256,16 +276,21 @@ impl Bolts {
 /// Confining stress normal to the bolt at its host (Pa, ≥ 0, compression): the mean
 /// normal stress over the directions perpendicular to the axis `a` (global), from the
 /// host's co-rotated stress `s` (xx, yy, xy in 2D; xx, yy, zz, xy, yz, xz in 3D) and
-/// its rotation (2D: the angle of the host's polar decomposition from the positions;
-/// 3D: the mechanics' rotation matrix R, global = R σ Rᵀ).
+/// its rotation: in 2D `rot` = r (cos θ, sin θ) with any scale r ≠ 0 (see
+/// [`rotation_2d`]; the stress along the axis is quadratic in it and divided by r²), in
+/// 3D the mechanics' rotation matrix R (global = R σ Rᵀ).
 fn confinement(d: usize, s: &[f64], a: &[f64; 3], rot: &[f64]) -> f64 {
     let (trace, saa) = if d == 2 {
-        let (c, sn) = (rot[0], rot[1]);
-        // a_c = Rᵀ a with R = [[c, −s], [s, c]].
+        let (mut c, mut sn) = (rot[0], rot[1]);
+        let mut r2 = c * c + sn * sn;
+        if r2 <= 0.0 {
+            (c, sn, r2) = (1.0, 0.0, 1.0);
+        }
+        // a_c = Rᵀ a with R = [[c, −s], [s, c]] (times r).
         let ac = [c * a[0] + sn * a[1], -sn * a[0] + c * a[1]];
         (
             s[0] + s[1],
-            ac[0] * ac[0] * s[0] + ac[1] * ac[1] * s[1] + 2.0 * ac[0] * ac[1] * s[2],
+            (ac[0] * ac[0] * s[0] + ac[1] * ac[1] * s[1] + 2.0 * ac[0] * ac[1] * s[2]) / r2,
         )
     } else {
         let ac: [f64; 3] =
@@ -281,26 +306,20 @@ fn confinement(d: usize, s: &[f64], a: &[f64; 3], rot: &[f64]) -> f64 {
     (-(trace - saa) / (d - 1) as f64).max(0.0)
 }
 
-/// cos and sin of the rotation of a triangle from its reference to its current
-/// positions (the polar decomposition's angle of F = Dx Dm⁻¹).
-fn rotation_2d(xr: &[f64], xc: &[f64]) -> [f64; 2] {
-    let dm = [xr[2] - xr[0], xr[4] - xr[0], xr[3] - xr[1], xr[5] - xr[1]];
+/// The rotation of a triangle from its reference to its current positions `xc` (x, y
+/// of its three nodes) as r (cos θ, sin θ), θ the polar decomposition's angle of
+/// F = D_x D_m⁻¹, scaled by r = det(D_m) |…| (any sign): computed as D_x adj(D_m) with
+/// the adjugate `adj` of the reference edge matrix, so without a division (the
+/// confinement only needs the direction; this runs for every bolt node every step).
+fn rotation_2d(adj: &[f64; 4], xc: &[f64]) -> [f64; 2] {
     let dx = [xc[2] - xc[0], xc[4] - xc[0], xc[3] - xc[1], xc[5] - xc[1]];
-    let det = dm[0] * dm[3] - dm[1] * dm[2];
-    let inv = [dm[3] / det, -dm[1] / det, -dm[2] / det, dm[0] / det];
     let f = [
-        dx[0] * inv[0] + dx[1] * inv[2],
-        dx[0] * inv[1] + dx[1] * inv[3],
-        dx[2] * inv[0] + dx[3] * inv[2],
-        dx[2] * inv[1] + dx[3] * inv[3],
+        dx[0] * adj[0] + dx[1] * adj[2],
+        dx[0] * adj[1] + dx[1] * adj[3],
+        dx[2] * adj[0] + dx[3] * adj[2],
+        dx[2] * adj[1] + dx[3] * adj[3],
     ];
-    let (y, x) = (f[2] - f[1], f[0] + f[3]);
-    let r = (x * x + y * y).sqrt();
-    if r > 0.0 {
-        [x / r, y / r]
-    } else {
-        [1.0, 0.0]
-    }
+    [f[0] + f[3], f[2] - f[1]]
 }
 
 /// Displacement of node `n` (m; z = 0 in 2D).
@@ -340,31 +359,118 @@ fn relative_disp<D: Dim>(n: &BoltNode, kin: &Kinematics<'_, D>) -> [f64; 3] {
 fn unit(v: [f64; 3]) -> ([f64; 3], f64) {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if l > 0.0 {
-        ([v[0] / l, v[1] / l, v[2] / l], l)
+        // One division, not three (per segment and bolt node every step).
+        let inv = 1.0 / l;
+        ([v[0] * inv, v[1] * inv, v[2] * inv], l)
     } else {
         ([0.0; 3], 0.0)
     }
 }
 
-/// Rayon blocks of at least this many segments or nodes (an item is cheap).
-const MIN_LEN: usize = 256;
+/// Bolt sets with fewer nodes than this run in one block on the calling thread. Measured
+/// on the FDEM tunnel bench (880 bolt nodes, about 20 µs of work per step, 2 threads):
+/// two halves in parallel were slower than one thread, the fork costing more than the
+/// work it shares.
+const PARALLEL_FROM: usize = 2048;
 
-/// What the node pass reads: the segments and their forces, the host stresses (and
-/// rotations in 3D).
-struct NodePass<'a> {
-    seg_dir: &'a [[f64; 3]],
-    seg_force: &'a [[f64; 3]],
+/// Nodes per work block of a larger set (whole bolts, so a block may hold more): small
+/// enough that rayon's stealing balances the threads.
+const BLOCK_NODES: usize = 512;
+
+/// Groups whole bolts (given their first nodes and segments, and the node count) into
+/// work blocks: one below `parallel_from` nodes ([`PARALLEL_FROM`]), else blocks of at
+/// least `block_nodes` ([`BLOCK_NODES`]; the last may be smaller); returns each block's
+/// first node and first segment.
+fn blocks(
+    node_offset: &[usize],
+    segment_offset: &[usize],
+    n_nodes: usize,
+    (parallel_from, block_nodes): (usize, usize),
+) -> Vec<(usize, usize)> {
+    let size = if n_nodes < parallel_from {
+        usize::MAX
+    } else {
+        block_nodes
+    };
+    let mut out: Vec<(usize, usize)> = Vec::new();
+    let mut last = None;
+    for (&n, &s) in node_offset.iter().zip(segment_offset) {
+        if last.is_none_or(|l| n - l >= size) {
+            out.push((n, s));
+            last = Some(n);
+        }
+    }
+    out
+}
+
+/// A segment's force vector on its end node's side (N: f e with f the axial force plus
+/// damping) and its current unit direction e.
+type SegmentOut = ([f64; 3], [f64; 3]);
+
+/// What the walk reads besides the kinematics: the host stresses (and rotations in 3D).
+struct Walk<'a> {
     stress: &'a [f64],
     rotation: &'a [f64],
 }
 
-impl NodePass<'_> {
+/// A block of whole bolts and the entries it writes: its segments' axial force, plastic
+/// elongation and state, its nodes' grout force and slip and force slots.
+struct Block<'a> {
+    first_segment: usize,
+    segments: &'a [Segment],
+    nodes: &'a [BoltNode],
+    axial: &'a mut [f64],
+    plastic: &'a mut [f64],
+    state: &'a mut [f64],
+    grout: &'a mut [f64],
+    slip: &'a mut [f64],
+    slots: &'a mut [f64],
+}
+
+impl Walk<'_> {
+    /// Walks every bolt of `b` from head to toe: at each node, the segment starting
+    /// there (axial force, eq. 138-142, plus damping, eq. 148), then the node with the
+    /// segments before and after it. Each segment is computed once; every entry is
+    /// written by one node or segment only (deterministic in any block split).
+    fn block<D: Dim>(&self, b: Block<'_>, kin: &Kinematics<'_, D>) {
+        let stride = (D::D + 2) * D::D;
+        let mut prev: Option<SegmentOut> = None;
+        for (i, n) in b.nodes.iter().enumerate() {
+            let next = (n.next != NONE).then(|| {
+                let s = n.next as usize - b.first_segment;
+                segment(
+                    &b.segments[s],
+                    kin,
+                    &mut b.axial[s],
+                    &mut b.plastic[s],
+                    &mut b.state[s],
+                )
+            });
+            // A bolt's first node has no previous segment (`prev` then holds the last
+            // segment of the bolt before, unused).
+            let before = if n.prev != NONE { prev.as_ref() } else { None };
+            self.node(
+                n,
+                before,
+                next.as_ref(),
+                kin,
+                &mut b.slots[i * stride..(i + 1) * stride],
+                &mut b.grout[i],
+                &mut b.slip[i],
+            );
+            prev = next;
+        }
+    }
+
     /// One bolt node: its bar forces (previous then next segment), the grout against its
     /// host with the host's confinement, the lateral grout and the face plate; writes its
     /// slot and its host's `D + 1` slots (`slots`), its grout force and slip.
+    #[allow(clippy::too_many_arguments)]
     fn node<D: Dim>(
         &self,
         n: &BoltNode,
+        prev: Option<&SegmentOut>,
+        next: Option<&SegmentOut>,
         kin: &Kinematics<'_, D>,
         slots: &mut [f64],
         grout: &mut f64,
@@ -374,21 +480,16 @@ impl NodePass<'_> {
         // Bar forces on the node: +f e as the start of the next segment, −f e as the
         // end of the previous one (fixed order: previous, next).
         let mut f = [0.0; 3];
-        if n.prev != NONE {
-            let g = self.seg_force[n.prev as usize];
+        if let Some((g, _)) = prev {
             (0..3).for_each(|k| f[k] -= g[k]);
         }
-        if n.next != NONE {
-            let g = self.seg_force[n.next as usize];
+        if let Some((g, _)) = next {
             (0..3).for_each(|k| f[k] += g[k]);
         }
         // Axis at the node: mean of the adjacent segments' current directions.
         let mut axis = [0.0; 3];
-        for s in [n.prev, n.next] {
-            if s != NONE {
-                let e = self.seg_dir[s as usize];
-                (0..3).for_each(|k| axis[k] += e[k]);
-            }
+        for (_, e) in [prev, next].into_iter().flatten() {
+            (0..3).for_each(|k| axis[k] += e[k]);
         }
         let (a, _) = unit(axis);
         // Against the host's material point where the node was grouted.
@@ -396,18 +497,20 @@ impl NodePass<'_> {
         let delta = r[0] * a[0] + r[1] * a[1] + r[2] * a[2];
         // Grout along the axis: bond-slip with the host's confinement.
         let mut fs = 0.0;
-        if n.k_axial > 0.0 {
+        let trial = n.k_axial * (delta - *slip);
+        if n.k_axial > 0.0 && trial.abs() <= n.cap_unconfined {
+            // Elastic under any confinement: the same force and slip as below, exactly.
+            fs = trial;
+        } else if n.k_axial > 0.0 {
             let e = n.host as usize;
             let mut rot = [0.0; 9];
             if d == 2 {
-                let (mut xr, mut xc) = ([0.0; 6], [0.0; 6]);
+                let mut xc = [0.0; 6];
                 for q in 0..3 {
-                    let node = n.host_nodes[q] as usize;
-                    xr[2 * q..2 * q + 2].copy_from_slice(&kin.coords[2 * node..2 * node + 2]);
-                    let p = kin.position(node);
+                    let p = kin.position(n.host_nodes[q] as usize);
                     xc[2 * q..2 * q + 2].copy_from_slice(&p[..2]);
                 }
-                rot[..2].copy_from_slice(&rotation_2d(&xr, &xc));
+                rot[..2].copy_from_slice(&rotation_2d(&n.ref_adj, &xc));
             } else {
                 rot.copy_from_slice(&self.rotation[9 * e..9 * e + 9]);
             }
@@ -437,68 +540,127 @@ impl NodePass<'_> {
     }
 }
 
+/// One segment: the axial force in total form from its elongation (eq. 138-142) into
+/// `axial`, `plastic`, `state`, plus damping on the relative axial velocity (eq. 148).
+fn segment<D: Dim>(
+    seg: &Segment,
+    kin: &Kinematics<'_, D>,
+    axial: &mut f64,
+    plastic: &mut f64,
+    state: &mut f64,
+) -> SegmentOut {
+    let d = D::D;
+    let (e, elongation) = segment_state(seg, kin);
+    let broken = SegmentState::from_value(*state) == SegmentState::Broken;
+    let (f, up, st) = seg.law.update(elongation, seg.l0, *plastic, broken);
+    *axial = f;
+    *plastic = up;
+    *state = st as i32 as f64;
+    let mut total = f;
+    if seg.damping > 0.0 && st != SegmentState::Broken {
+        let (a, b) = (seg.n[0] as usize * d, seg.n[1] as usize * d);
+        let rel: f64 = (0..d).map(|k| (kin.v[b + k] - kin.v[a + k]) * e[k]).sum();
+        total += seg.damping * rel;
+    }
+    ([total * e[0], total * e[1], total * e[2]], e)
+}
+
 impl Bolts {
-    /// The segment pass, then the node pass (see `compute_forces`).
+    /// Every bolt's segments and nodes in one walk per block (see [`Walk::block`]);
+    /// blocks run in parallel when there are several.
     fn passes<D: Dim>(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let d = D::D;
         let ids = self.ids.expect("init ran");
         let kin = &ctx.kin;
-        // Segments: axial force (total form) plus damping on the relative velocity. Each
-        // segment and each node writes only its own entries: parallel and deterministic.
+        // The host's stress (and rotation in 3D) are read in place.
+        let ([axial, plastic, state, grout, slip], stress, rotation) = if let Some(r) = ids.rotation
         {
-            let [axial, plastic, state] =
-                ctx.fields.get_many_mut([ids.axial, ids.plastic, ids.state]);
-            self.segments
-                .par_iter()
-                .zip(
-                    self.seg_force
-                        .par_iter_mut()
-                        .zip(self.seg_dir.par_iter_mut()),
-                )
-                .zip(axial.par_iter_mut())
-                .zip(plastic.par_iter_mut().zip(state.par_iter_mut()))
-                .with_min_len(MIN_LEN)
-                .for_each(|(((seg, (force, dir)), axial), (plastic, state))| {
-                    let (e, elongation) = segment_state(seg, kin);
-                    *dir = e;
-                    let broken = SegmentState::from_value(*state) == SegmentState::Broken;
-                    let (f, up, st) = seg.law.update(elongation, seg.l0, *plastic, broken);
-                    *axial = f;
-                    *plastic = up;
-                    *state = st as i32 as f64;
-                    let mut total = f;
-                    if seg.damping > 0.0 && st != SegmentState::Broken {
-                        let (a, b) = (seg.n[0] as usize * d, seg.n[1] as usize * d);
-                        let rel: f64 = (0..d).map(|k| (kin.v[b + k] - kin.v[a + k]) * e[k]).sum();
-                        total += seg.damping * rel;
-                    }
-                    *force = [total * e[0], total * e[1], total * e[2]];
-                });
-        }
-        // Nodes: the host's stress (and rotation in 3D) are read in place.
-        let (grout, slip, stress, rotation) = if let Some(r) = ids.rotation {
-            let [g, s, st, rot] = ctx
-                .fields
-                .get_many_mut([ids.grout, ids.slip, ids.stress, r]);
-            (g, s, &*st, &*rot)
+            let [a, p, st, g, sl, stress, rot] = ctx.fields.get_many_mut([
+                ids.axial,
+                ids.plastic,
+                ids.state,
+                ids.grout,
+                ids.slip,
+                ids.stress,
+                r,
+            ]);
+            ([a, p, st, g, sl], &*stress, &*rot)
         } else {
-            let [g, s, st] = ctx.fields.get_many_mut([ids.grout, ids.slip, ids.stress]);
-            (g, s, &*st, &[][..])
+            let [a, p, st, g, sl, stress] = ctx.fields.get_many_mut([
+                ids.axial,
+                ids.plastic,
+                ids.state,
+                ids.grout,
+                ids.slip,
+                ids.stress,
+            ]);
+            ([a, p, st, g, sl], &*stress, &[][..])
         };
-        let pass = NodePass {
-            seg_dir: &self.seg_dir,
-            seg_force: &self.seg_force,
-            stress,
-            rotation,
+        let walk = Walk { stress, rotation };
+        let whole = Block {
+            first_segment: 0,
+            segments: &self.segments,
+            nodes: &self.nodes,
+            axial,
+            plastic,
+            state,
+            grout,
+            slip,
+            slots: ctx.slots,
         };
-        ctx.slots
-            .par_chunks_mut((d + 2) * d)
-            .zip(self.nodes.par_iter())
-            .zip(grout.par_iter_mut().zip(slip.par_iter_mut()))
-            .with_min_len(MIN_LEN)
-            .for_each(|((slots, n), (grout, slip))| pass.node(n, kin, slots, grout, slip));
+        if self.blocks.len() <= 1 {
+            walk.block(whole, kin);
+        } else {
+            split_blocks(whole, &self.blocks, (d + 2) * d)
+                .into_par_iter()
+                .for_each(|b| walk.block(b, kin));
+        }
         Ok(())
     }
+}
+
+/// Cuts `whole` at the blocks' first nodes and segments (`stride` slot values per node).
+fn split_blocks<'a>(
+    mut rest: Block<'a>,
+    blocks: &[(usize, usize)],
+    stride: usize,
+) -> Vec<Block<'a>> {
+    let mut out = Vec::with_capacity(blocks.len());
+    for w in blocks.windows(2) {
+        let (n, s) = (w[1].0 - w[0].0, w[1].1 - w[0].1);
+        let (axial, axial_r) = std::mem::take(&mut rest.axial).split_at_mut(s);
+        let (plastic, plastic_r) = std::mem::take(&mut rest.plastic).split_at_mut(s);
+        let (state, state_r) = std::mem::take(&mut rest.state).split_at_mut(s);
+        let (grout, grout_r) = std::mem::take(&mut rest.grout).split_at_mut(n);
+        let (slip, slip_r) = std::mem::take(&mut rest.slip).split_at_mut(n);
+        let (slots, slots_r) = std::mem::take(&mut rest.slots).split_at_mut(n * stride);
+        let (segments, segments_r) = rest.segments.split_at(s);
+        let (nodes, nodes_r) = rest.nodes.split_at(n);
+        out.push(Block {
+            first_segment: w[0].1,
+            segments,
+            nodes,
+            axial,
+            plastic,
+            state,
+            grout,
+            slip,
+            slots,
+        });
+        rest = Block {
+            first_segment: w[1].1,
+            segments: segments_r,
+            nodes: nodes_r,
+            axial: axial_r,
+            plastic: plastic_r,
+            state: state_r,
+            grout: grout_r,
+            slip: slip_r,
+            slots: slots_r,
+        };
+    }
+    out.push(rest);
+    out
 }
 
 impl<D: Dim> Physics<D> for Bolts {
@@ -593,8 +755,12 @@ impl<D: Dim> Physics<D> for Bolts {
         }
         ctx.fields.get_mut(ids.plastic).copy_from_slice(&plastic);
         self.ids = Some(ids);
-        self.seg_force = vec![[0.0; 3]; self.segments.len()];
-        self.seg_dir = vec![[0.0; 3]; self.segments.len()];
+        self.blocks = blocks(
+            &self.node_offset,
+            &self.segment_offset,
+            self.nodes.len(),
+            self.blocking,
+        );
         Ok(())
     }
 
@@ -939,5 +1105,77 @@ impl<D: Dim> Physics<D> for BoltBoundary {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Bolt, BoltMaterial, BoltProperties};
+    use pcdc_compute::{Backend, Simulation};
+    use pcdc_mech::{LinearElastic, Mechanics};
+    use pcdc_mesh::{builders, Dim2, Range};
+
+    #[test]
+    fn blocks_hold_whole_bolts_and_start_parallel_work_at_the_threshold() {
+        // Bolts of 3, 5, 3, 4 nodes (2, 4, 2, 3 segments).
+        let (nodes, segs) = ([0, 3, 8, 11], [0, 2, 6, 8]);
+        assert_eq!(blocks(&nodes, &segs, 15, (16, 4)), vec![(0, 0)]);
+        assert_eq!(
+            blocks(&nodes, &segs, 15, (15, 4)),
+            vec![(0, 0), (8, 6)],
+            "whole bolts of at least 4 nodes"
+        );
+        assert_eq!(blocks(&nodes, &segs, 15, (1, 1)).len(), 4);
+    }
+
+    /// A plate under gravity with 60 pretensioned, plated bolts, run with `blocking`.
+    fn bolted_plate(blocking: (usize, usize)) -> Simulation<Dim2> {
+        let mesh = builders::rectangle(0.0, 0.0, 4.0, 1.0, 0.1).unwrap();
+        let props = BoltProperties {
+            cohesion_rock_grout: 2e3,
+            pretension: 4e4,
+            ..BoltProperties::steel_rebar(0.02)
+        };
+        let material = BoltMaterial::new(props).unwrap();
+        let mut bolts = Bolts::new();
+        for i in 0..60 {
+            let x = 0.05 + 3.9 * i as f64 / 59.0;
+            let (head, tail) = ([x, 0.97, 0.0], [x + 0.02, 0.1 + 0.01 * i as f64, 0.0]);
+            let bolt = Bolt::straight(format!("B{i}"), head, tail, 10, material)
+                .unwrap()
+                .free_length(0.2)
+                .unwrap()
+                .face_plate(1e7)
+                .unwrap();
+            bolts = bolts.bolt(bolt).unwrap();
+        }
+        bolts.blocking = blocking;
+        let rock = LinearElastic::new(2e8, 0.25, 2000.0).unwrap();
+        Simulation::builder(mesh, Backend::cpu(2).unwrap())
+            .physics(Mechanics::new().material(Range::All, rock))
+            .physics(bolts)
+            .gravity([0.0, -9.81, 0.0])
+            .build()
+            .unwrap()
+    }
+
+    #[test]
+    fn bolts_split_in_blocks_give_the_single_block_result_bit_for_bit() {
+        let (mut one, mut split) = (bolted_plate((usize::MAX, 1)), bolted_plate((1, 50)));
+        one.run(300).unwrap();
+        split.run(300).unwrap();
+        assert_eq!(one.state.u, split.state.u);
+        for name in [BOLT_AXIAL_FORCE, BOLT_GROUT_FORCE, BOLT_SLIP, BOLT_STATE] {
+            assert_eq!(
+                one.field(name).unwrap(),
+                split.field(name).unwrap(),
+                "{name:?}"
+            );
+        }
+        // Something happened: the bolts carry force and the grout has slipped somewhere.
+        let axial = one.field(BOLT_AXIAL_FORCE).unwrap();
+        assert!(axial.iter().any(|f| f.abs() > 1e3), "{axial:?}");
+        assert!(one.field(BOLT_SLIP).unwrap().iter().any(|s| *s != 0.0));
     }
 }

@@ -14,7 +14,8 @@
 fn unit4(v: array<Real, 3>) -> array<Real, 4> {
     let l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     if l > 0.0 {
-        return array<Real, 4>(v[0] / l, v[1] / l, v[2] / l, l);
+        let inv = 1.0 / l;
+        return array<Real, 4>(v[0] * inv, v[1] * inv, v[2] * inv, l);
     }
     return array<Real, 4>(0.0, 0.0, 0.0, 0.0);
 }
@@ -98,7 +99,8 @@ fn position(n: u32) -> array<Real, 3> {
     return p;
 }
 
-// Rotation (cos, sin) of a triangle from its reference to its current positions.
+// Rotation of a triangle from its reference to its current positions as r (cos, sin),
+// r = det(Dm) |..| of any sign: Dx adj(Dm), without a division (as on the CPU).
 fn rotation_2d(h: array<u32, 4>) -> array<Real, 2> {
     var xr: array<Real, 6>;
     var xc: array<Real, 6>;
@@ -113,26 +115,19 @@ fn rotation_2d(h: array<u32, 4>) -> array<Real, 2> {
     let dm1 = xr[4] - xr[0];
     let dm2 = xr[3] - xr[1];
     let dm3 = xr[5] - xr[1];
+    let i0 = dm3;
+    let i1 = -dm1;
+    let i2 = -dm2;
+    let i3 = dm0;
     let dx0 = xc[2] - xc[0];
     let dx1 = xc[4] - xc[0];
     let dx2 = xc[3] - xc[1];
     let dx3 = xc[5] - xc[1];
-    let det = dm0 * dm3 - dm1 * dm2;
-    let i0 = dm3 / det;
-    let i1 = -dm1 / det;
-    let i2 = -dm2 / det;
-    let i3 = dm0 / det;
     let f0 = dx0 * i0 + dx1 * i2;
     let f1 = dx0 * i1 + dx1 * i3;
     let f2 = dx2 * i0 + dx3 * i2;
     let f3 = dx2 * i1 + dx3 * i3;
-    let y = f2 - f1;
-    let x = f0 + f3;
-    let r = sqrt(x * x + y * y);
-    if r > 0.0 {
-        return array<Real, 2>(x / r, y / r);
-    }
-    return array<Real, 2>(1.0, 0.0);
+    return array<Real, 2>(f0 + f3, f2 - f1);
 }
 
 // Mean compressive normal stress across the axis a at host element e (≥ 0).
@@ -141,15 +136,21 @@ fn confinement(e: u32, a: array<Real, 4>, h: array<u32, 4>) -> Real {
     var saa: Real;
     if D == 2u {
         let rot = rotation_2d(h);
-        let c = rot[0];
-        let sn = rot[1];
+        var c = rot[0];
+        var sn = rot[1];
+        var r2 = c * c + sn * sn;
+        if r2 <= 0.0 {
+            c = 1.0;
+            sn = 0.0;
+            r2 = 1.0;
+        }
         let ac0 = c * a[0] + sn * a[1];
         let ac1 = -sn * a[0] + c * a[1];
         let s0 = stress[NSYM * e];
         let s1 = stress[NSYM * e + 1u];
         let s2 = stress[NSYM * e + 2u];
         trace = s0 + s1;
-        saa = ac0 * ac0 * s0 + ac1 * ac1 * s1 + 2.0 * ac0 * ac1 * s2;
+        saa = (ac0 * ac0 * s0 + ac1 * ac1 * s1 + 2.0 * ac0 * ac1 * s2) / r2;
     } else {
         var ac: array<Real, 3>;
         for (var i = 0u; i < 3u; i = i + 1u) {
