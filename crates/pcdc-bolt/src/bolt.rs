@@ -1,7 +1,7 @@
 //! A bolt's geometry: a polyline of two-node bar segments from the head (node 0, at the
 //! excavation face, where a face plate bears) to the tail (the far, anchored end),
-//! placed by its end points and a segment count, by its node positions, or from a 2D
-//! Gmsh line group.
+//! placed by its end points and a segment count, by its node positions, along lines
+//! (a 2D face group, or a Gmsh curve group in 2D or 3D).
 
 use pcdc_mesh::{Dim, Mesh};
 
@@ -28,6 +28,13 @@ fn finite(name: &str, p: &[f64; 3]) -> Result<(), BoltError> {
             reason: format!("point {p:?} is not finite"),
         })
     }
+}
+
+/// Node `n` of `mesh` as a 3-vector (m; z = 0 in 2D).
+fn position<D: Dim>(mesh: &Mesh<D>, n: u32) -> [f64; 3] {
+    let mut p = [0.0; 3];
+    p[..D::D].copy_from_slice(mesh.node(n as usize));
+    p
 }
 
 fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
@@ -123,7 +130,7 @@ impl Bolt {
         };
         if D::D != 2 {
             return Err(geometry(
-                "a bolt from a face group needs a 2D mesh (in 3D give its end points)".into(),
+                "a bolt from a face group needs a 2D mesh (in 3D use Bolt::from_line_group)".into(),
             ));
         }
         let faces = mesh
@@ -131,24 +138,84 @@ impl Bolt {
             .faces
             .get(group)
             .ok_or_else(|| geometry(format!("the mesh has no face group '{group}'")))?;
-        // Chain the lines by position (split copies of a vertex share it).
-        let key = |n: u32| {
-            let x = mesh.node(n as usize);
-            [x[0].to_bits(), x[1].to_bits()]
+        let lines: Vec<[[f64; 3]; 2]> = faces
+            .iter()
+            .map(|&f| {
+                let nodes = mesh.face(f as usize);
+                [position(mesh, nodes[0]), position(mesh, nodes[1])]
+            })
+            .collect();
+        let what = format!("face group '{group}'");
+        Self::chained(name, &lines, head_near, material, &what)
+    }
+
+    /// A bolt along the lines of physical curve group `group` of a Gmsh import
+    /// ([`MshImport::lines`](pcdc_mesh::gmsh::MshImport::lines)), in 2D or 3D: one segment
+    /// per line, chained into one open polyline whose head is the end nearer to
+    /// `head_near` (m). Mesh the curve embedded in the volume (Gmsh `fragment` or
+    /// `embed`, as `meshes/make_specimens.py` does), so that every bolt node lies on an
+    /// element's edge. Errors if the import has no such curve group or its lines do not
+    /// form one open chain.
+    pub fn from_line_group<D: Dim>(
+        name: impl Into<String>,
+        import: &pcdc_mesh::gmsh::MshImport<D>,
+        group: &str,
+        head_near: [f64; 3],
+        material: BoltMaterial,
+    ) -> Result<Self, BoltError> {
+        let name = name.into();
+        let pairs = import.lines.get(group).ok_or_else(|| BoltError::Geometry {
+            bolt: name.clone(),
+            reason: format!("the Gmsh import has no physical curve group '{group}'"),
+        })?;
+        let mesh = &import.mesh;
+        let lines: Vec<[[f64; 3]; 2]> = pairs
+            .iter()
+            .map(|&[a, b]| [position(mesh, a), position(mesh, b)])
+            .collect();
+        let what = format!("curve group '{group}'");
+        Self::chained(name, &lines, head_near, material, &what)
+    }
+
+    /// A bolt along `lines` (pairs of end points, m, in any order and orientation),
+    /// chained into one open polyline by shared end points (equal coordinates), head
+    /// at the end nearer to `head_near`. Errors if the lines do not form one open chain.
+    pub fn from_lines(
+        name: impl Into<String>,
+        lines: &[[[f64; 3]; 2]],
+        head_near: [f64; 3],
+        material: BoltMaterial,
+    ) -> Result<Self, BoltError> {
+        Self::chained(name.into(), lines, head_near, material, "the lines")
+    }
+
+    /// Chains `lines` (`what` names them in errors) into one open polyline from the end
+    /// nearer to `head_near`.
+    fn chained(
+        name: String,
+        lines: &[[[f64; 3]; 2]],
+        head_near: [f64; 3],
+        material: BoltMaterial,
+        what: &str,
+    ) -> Result<Self, BoltError> {
+        let geometry = |reason: String| BoltError::Geometry {
+            bolt: name.clone(),
+            reason,
         };
-        let mut points: Vec<[u64; 2]> = Vec::new();
+        // Chain by position (split copies of a vertex share it).
+        let key = |x: &[f64; 3]| x.map(f64::to_bits);
+        let mut points: Vec<[u64; 3]> = Vec::new();
         let mut edges: Vec<(usize, usize)> = Vec::new();
-        let index = |k: [u64; 2], points: &mut Vec<[u64; 2]>| {
+        let index = |k: [u64; 3], points: &mut Vec<[u64; 3]>| {
             points.iter().position(|p| *p == k).unwrap_or_else(|| {
                 points.push(k);
                 points.len() - 1
             })
         };
-        for &f in faces {
-            let nodes = mesh.face(f as usize);
-            let a = index(key(nodes[0]), &mut points);
-            let b = index(key(nodes[1]), &mut points);
-            if !edges.contains(&(a, b)) && !edges.contains(&(b, a)) {
+        for [p, q] in lines {
+            let a = index(key(p), &mut points);
+            let b = index(key(q), &mut points);
+            if a != b && !edges.contains(&(a, b)) && !edges.contains(&(b, a)) {
                 edges.push((a, b));
             }
         }
@@ -160,17 +227,11 @@ impl Bolt {
         let ends: Vec<usize> = (0..points.len()).filter(|&p| degree[p] == 1).collect();
         if edges.is_empty() || ends.len() != 2 || degree.iter().any(|&d| d > 2) {
             return Err(geometry(format!(
-                "face group '{group}' ({} lines) is not one open chain of lines",
+                "{what} ({} lines) is not one open chain of lines",
                 edges.len()
             )));
         }
-        let pos = |p: usize| {
-            [
-                f64::from_bits(points[p][0]),
-                f64::from_bits(points[p][1]),
-                0.0,
-            ]
-        };
+        let pos = |p: usize| points[p].map(f64::from_bits);
         let head = if dist(&pos(ends[0]), &head_near) <= dist(&pos(ends[1]), &head_near) {
             ends[0]
         } else {
@@ -187,7 +248,7 @@ impl Bolt {
         }
         if chain.len() != edges.len() + 1 {
             return Err(geometry(format!(
-                "face group '{group}' is not one connected chain of lines"
+                "{what} is not one connected chain of lines"
             )));
         }
         let pts: Vec<[f64; 3]> = chain.into_iter().map(pos).collect();

@@ -78,3 +78,55 @@ fn bolts_are_written_as_vtu_lines_and_csv_histories() {
     assert!(last[1] > 0.0, "{text}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The shipped 3D block (`meshes/make_specimens.py`): a bolt along a Gmsh curve group
+/// embedded in tetrahedra, chained from the collar, pulled at its head. The grout hands
+/// the pull to the rock along the bolt: the axial force falls from the head towards the
+/// tail.
+#[test]
+fn a_bolt_along_a_3d_gmsh_curve_group_is_chained_and_carries_a_pull() {
+    use pcdc_mesh::gmsh::{read_msh_with, ImportOptions};
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../meshes/bolted_block_s50mm.msh"
+    );
+    let import = read_msh_with::<pcdc_mesh::Dim3>(path, &ImportOptions::default()).unwrap();
+    let m = BoltMaterial::new(BoltProperties::steel_rebar(0.02)).unwrap();
+    let bolt = Bolt::from_line_group("B", &import, "bolt", [0.2, 0.2, 0.7], m).unwrap();
+    let pts = bolt.points();
+    let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-9);
+    assert!(close(pts[0], [0.2, 0.2, 0.6]), "head {:?}", pts[0]);
+    assert!(close(*pts.last().unwrap(), [0.25, 0.22, 0.1]), "tail {:?}", pts.last());
+    let exact = 0.3 + (0.05f64.powi(2) + 0.02f64.powi(2) + 0.2f64.powi(2)).sqrt();
+    assert!((bolt.length() - exact).abs() < 1e-9, "{} vs {exact}", bolt.length());
+    assert_eq!(bolt.segments(), import.lines["bolt"].len());
+    assert!(bolt.segments() >= 8, "{} segments", bolt.segments());
+    // Head chosen by `head_near`: from the tail's side the chain runs the other way.
+    let reversed = Bolt::from_line_group("R", &import, "bolt", [0.25, 0.22, 0.0], m).unwrap();
+    assert!(close(reversed.points()[0], [0.25, 0.22, 0.1]));
+    let e = Bolt::from_line_group("X", &import, "nowhere", [0.0; 3], m).unwrap_err();
+    assert!(e.to_string().contains("nowhere"), "{e}");
+
+    let bolts = Bolts::new().bolt(bolt).unwrap();
+    let pull = bolts
+        .boundary()
+        .velocity("B", BoltNodes::Head, [None, None, Some(0.05.into())])
+        .unwrap();
+    let mut sim = Simulation::builder(import.mesh, Backend::cpu(1).unwrap())
+        .physics(
+            Mechanics::new().material(Range::All, LinearElastic::new(10e9, 0.2, 2500.0).unwrap()),
+        )
+        .physics(Boundary::new().fix(Range::group("bottom")))
+        .physics(bolts)
+        .physics(pull)
+        .build()
+        .unwrap();
+    sim.run(300).unwrap();
+    let axial = sim.field(pcdc_bolt::BOLT_AXIAL_FORCE).unwrap();
+    eprintln!("axial force from the head (N): {axial:?}");
+    assert!(axial[0] > 0.0, "the head segment is in tension: {axial:?}");
+    assert!(
+        axial[axial.len() - 1].abs() < 0.5 * axial[0],
+        "the grout takes the pull off along the bolt: {axial:?}"
+    );
+}

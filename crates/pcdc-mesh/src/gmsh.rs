@@ -27,7 +27,9 @@
 //!     gives a face group (each line/triangle is matched with the mesh face with the same
 //!     nodes, a quadrangle with the two triangles a hexahedron's face is cut into; an
 //!     element that is no face of the mesh is an error naming its line) and a node group;
-//!   - lower-dimensional physical groups (points, and curves in 3D) give node groups.
+//!   - lower-dimensional physical groups (points, and curves in 3D) give node groups;
+//!   - every physical curve group (2D or 3D) also gives its 2-node lines, as pairs of
+//!     mesh nodes, in [`MshImport::lines`] (the path of a bolt along an embedded curve).
 //!
 //!   Node groups of the same name from different dimensions are merged. Lower-dimensional
 //!   elements that belong to no physical group are ignored, whatever their type.
@@ -73,6 +75,11 @@ pub struct MshImport<D: Dim> {
     /// Number of nodes merged into a coincident node of lower tag
     /// ([`ImportOptions::merge_coincident`]).
     pub merged_nodes: usize,
+    /// The 2-node line elements of every physical curve group (in 2D and 3D), by group
+    /// name, as pairs of mesh node indices in the file's order: the path of a bolt or
+    /// cable drilled along an embedded curve (`pcdc_bolt::Bolt::from_line_group`). The
+    /// mesh's own groups keep a 3D curve as a node group only.
+    pub lines: BTreeMap<String, Vec<[u32; 2]>>,
 }
 
 use crate::MAX_COORD;
@@ -1054,6 +1061,7 @@ fn build_mesh<D: Dim>(
     let mut node_groups: BTreeMap<String, Vec<u32>> = BTreeMap::new();
     let mut elem_groups: BTreeMap<String, Vec<u32>> = BTreeMap::new();
     let mut face_groups: BTreeMap<String, Vec<u32>> = BTreeMap::new();
+    let mut line_groups: BTreeMap<String, Vec<[u32; 2]>> = BTreeMap::new();
     // Named physical groups exist even when they hold no element.
     for (&(dim, _), name) in &raw.names {
         if dim > d {
@@ -1181,6 +1189,12 @@ fn build_mesh<D: Dim>(
             };
             for &p in phys {
                 let name = name_of(b.dim, p);
+                if b.dim == 1 && tags.len() == 2 {
+                    line_groups
+                        .entry(name.clone())
+                        .or_default()
+                        .push([key[0], key[1]]);
+                }
                 face_groups
                     .entry(name.clone())
                     .or_default()
@@ -1207,6 +1221,7 @@ fn build_mesh<D: Dim>(
         mesh,
         warnings,
         merged_nodes,
+        lines: line_groups,
     })
 }
 
@@ -1375,6 +1390,16 @@ mod tests {
         assert!((n[0] + 1.0).abs() < 1e-14, "left face normal {n:?}");
         assert!(!g.faces.contains_key("rock"));
         assert!(!g.elements.contains_key("left"));
+        // The curve groups' lines, as mesh node pairs; points and surfaces have none.
+        let lines = read_msh_with::<Dim2>(data("square.msh"), &ImportOptions::default())
+            .unwrap()
+            .lines;
+        let sorted = |v: &[[u32; 2]]| -> Vec<[u32; 2]> {
+            v.iter().map(|&[a, b]| [a.min(b), a.max(b)]).collect()
+        };
+        assert_eq!(sorted(&lines["left"]), vec![[0, 3]]);
+        assert_eq!(sorted(&lines["right"]), vec![[1, 2]]);
+        assert!(!lines.contains_key("origin") && !lines.contains_key("rock"));
     }
 
     #[test]
