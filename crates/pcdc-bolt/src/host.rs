@@ -5,6 +5,10 @@
 
 use pcdc_mesh::{Dim, Mesh};
 
+/// Barycentric weights (dimensionless) this close count as equal when choosing a host:
+/// a point on an element face lies on it to rounding, which may fall either way.
+pub(crate) const TIE: f64 = 1e-12;
+
 /// Barycentric coordinates of `p` in the simplex with vertices `x` (stride `d`, d + 1
 /// vertices): weights summing to 1, all in [0, 1] inside.
 pub fn barycentric(d: usize, x: &[f64], p: &[f64]) -> [f64; 4] {
@@ -124,8 +128,10 @@ impl<'a, D: Dim> Locator<'a, D> {
     }
 
     /// The element holding `p` (m): the one whose smallest barycentric weight is largest
-    /// (so a point on a shared face or vertex picks one element, the lowest index on a
-    /// tie), if that weight is above `-tol` (relative). `None` outside the mesh.
+    /// (so a point on a shared face or vertex picks one element: the lowest index among
+    /// those within [`TIE`] of the largest, so that rounding, e.g. of a change of units,
+    /// does not pick another), if that weight is above `-tol` (relative). `None` outside
+    /// the mesh.
     pub fn locate(&self, p: &[f64], tol: f64) -> Option<Host> {
         let d = D::D;
         let mut c = [0usize; 3];
@@ -147,7 +153,7 @@ impl<'a, D: Dim> Locator<'a, D> {
             let min = w[..=d].iter().cloned().fold(f64::INFINITY, f64::min);
             let better = match &best {
                 None => true,
-                Some((m, h)) => min > *m || (min == *m && (e as usize) < h.element),
+                Some((m, h)) => min > *m + TIE || (min >= *m - TIE && (e as usize) < h.element),
             };
             if better {
                 best = Some((

@@ -96,9 +96,17 @@ fn a_bolt_along_a_3d_gmsh_curve_group_is_chained_and_carries_a_pull() {
     let pts = bolt.points();
     let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-9);
     assert!(close(pts[0], [0.2, 0.2, 0.6]), "head {:?}", pts[0]);
-    assert!(close(*pts.last().unwrap(), [0.25, 0.22, 0.1]), "tail {:?}", pts.last());
+    assert!(
+        close(*pts.last().unwrap(), [0.25, 0.22, 0.1]),
+        "tail {:?}",
+        pts.last()
+    );
     let exact = 0.3 + (0.05f64.powi(2) + 0.02f64.powi(2) + 0.2f64.powi(2)).sqrt();
-    assert!((bolt.length() - exact).abs() < 1e-9, "{} vs {exact}", bolt.length());
+    assert!(
+        (bolt.length() - exact).abs() < 1e-9,
+        "{} vs {exact}",
+        bolt.length()
+    );
     assert_eq!(bolt.segments(), import.lines["bolt"].len());
     assert!(bolt.segments() >= 8, "{} segments", bolt.segments());
     // Head chosen by `head_near`: from the tail's side the chain runs the other way.
