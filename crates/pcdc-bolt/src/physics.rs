@@ -568,7 +568,7 @@ fn segment<D: Dim>(
 impl Bolts {
     /// Every bolt's segments and nodes in one walk per block (see [`Walk::block`]);
     /// blocks run in parallel when there are several.
-    fn passes<D: Dim>(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
+    fn walk<D: Dim>(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
         let d = D::D;
         let ids = self.ids.expect("init ran");
         let kin = &ctx.kin;
@@ -829,10 +829,10 @@ impl<D: Dim> Physics<D> for Bolts {
     }
 
     fn compute_forces(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
-        // Both passes on the backend's pool (its thread count; a parallel iterator
-        // outside it runs on rayon's global pool), entered once per step.
+        // The walk on the backend's pool (its thread count; a parallel iterator outside
+        // it runs on rayon's global pool), entered once per step.
         let backend = ctx.backend;
-        backend.install(|| self.passes(ctx))
+        backend.install(|| self.walk(ctx))
     }
 
     fn stored_energy(&self, kin: &Kinematics<'_, D>, fields: &FieldStore) -> f64 {
