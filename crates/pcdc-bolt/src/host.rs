@@ -129,7 +129,7 @@ impl<'a, D: Dim> Locator<'a, D> {
 
     /// The element holding `p` (m): the one whose smallest barycentric weight is largest
     /// (so a point on a shared face or vertex picks one element: the lowest index among
-    /// those within [`TIE`] of the largest, so that rounding, e.g. of a change of units,
+    /// those within 1e-12 of the largest, so that rounding, e.g. of a change of units,
     /// does not pick another), if that weight is above `-tol` (relative). `None` outside
     /// the mesh.
     pub fn locate(&self, p: &[f64], tol: f64) -> Option<Host> {
