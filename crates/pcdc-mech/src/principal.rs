@@ -30,7 +30,8 @@ pub struct Principal {
     pub axes: [[f64; 3]; 3],
 }
 
-/// Decomposes `t` (xx, yy, zz, xy, yz, xz) into principal values and axes.
+/// Decomposes `t` (xx, yy, zz, xy, yz, xz) into principal values and axes. Components
+/// up to 1e150 in magnitude (a rotation squares them).
 pub fn principal(t: &Sym6) -> Principal {
     let mut a = [[t[0], t[3], t[5]], [t[3], t[1], t[4]], [t[5], t[4], t[2]]];
     let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
@@ -71,19 +72,30 @@ pub fn principal(t: &Sym6) -> Principal {
     }
 }
 
-/// One Jacobi rotation zeroing `a[p][q]` (Numerical Recipes' stable form).
+/// One Jacobi rotation zeroing `a[p][q]`. With d = a_qq − a_pp and ρ = √(d² + 4a_pq²),
+/// the rotation's tangent is t = sgn(d) 2a_pq / (ρ + |d|) (the smaller root of
+/// t² + 2θt − 1 = 0, θ = d / 2a_pq, as in Numerical Recipes) and its cosine
+/// c = √((ρ + |d|) / 2ρ) (= 1/√(1 + t²)). Neither cancels, and the chain of slow
+/// operations is a root, a division and a root (the θ form takes two roots and three
+/// divisions one after another): the rotation is most of a plastic element's step in 3D.
 fn rotate(a: &mut [[f64; 3]; 3], v: &mut [[f64; 3]; 3], p: usize, q: usize) {
     let apq = a[p][q];
     if apq == 0.0 {
         return;
     }
-    let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
-    let t = if theta >= 0.0 {
-        1.0 / (theta + (theta * theta + 1.0).sqrt())
+    let d = a[q][q] - a[p][p];
+    let rho = (d * d + 4.0 * apq * apq).sqrt();
+    let e = rho + d.abs();
+    if e <= 0.0 {
+        // a_pq² underflowed (|a_pq| < 1e-154 with d = 0): nothing to rotate at f64 scale.
+        return;
+    }
+    let t = if d >= 0.0 {
+        2.0 * apq / e
     } else {
-        -1.0 / (-theta + (theta * theta + 1.0).sqrt())
+        -2.0 * apq / e
     };
-    let c = 1.0 / (t * t + 1.0).sqrt();
+    let c = (e / (2.0 * rho)).sqrt();
     let s = t * c;
     let r = 3 - p - q; // the third index
     let (app, aqq, apr, aqr) = (a[p][p], a[q][q], a[p][r], a[q][r]);
@@ -253,6 +265,35 @@ mod tests {
                 assert!(close(a[k], b[k], sc), "{c:?} {k}: {} vs {}", a[k], b[k]);
             }
         }
+    }
+
+    #[test]
+    fn round_trips_at_any_scale_and_near_diagonal() {
+        // Scales from tiny to large, a nearly diagonal tensor (one rotation of a small
+        // angle), and an off-diagonal so small that its square underflows.
+        for scale in [1e-140, 1e-3, 1.0, 3e7, 1e140] {
+            for t in [
+                [3.0, -2.0, 0.5, 1.25, -0.75, 2.0],
+                [-33.6, -10.04, -10.03, 1e-4, -5e-4, 2e-6],
+                [1.0, 1.0, 1.0, 1e-9, 0.0, 1e-9],
+            ] {
+                let t = t.map(|v| v * scale);
+                let p = principal(&t);
+                let back = compose(&p.values, &p.axes);
+                let m = t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for k in 0..6 {
+                    assert!(
+                        close(back[k], t[k], 4.0 * m),
+                        "{scale} {k}: {} vs {}",
+                        back[k],
+                        t[k]
+                    );
+                }
+            }
+        }
+        let p = principal(&[2.0, 2.0, 1.0, 1e-170, 0.0, 1e-170]);
+        assert!(p.values.iter().all(|v| v.is_finite()));
+        assert_eq!(p.values, [1.0, 2.0, 2.0]);
     }
 
     #[test]

@@ -282,20 +282,24 @@ fn mc_return(f: McSurf, s: McV3, min_pos: Real) -> McRet {
     return best;
 }
 
-// One Jacobi rotation zeroing a[p][q] (principal.rs: rotate).
+// One Jacobi rotation zeroing a[p][q] (principal.rs: rotate; t = sgn(d) 2a_pq/(ρ + |d|),
+// c = √((ρ + |d|)/2ρ)).
 fn mc_rotate(a: ptr<function, array<McV3, 3>>, v: ptr<function, array<McV3, 3>>, p: u32, q: u32) {
     let apq = (*a)[p][q];
     if apq == 0.0 {
         return;
     }
-    let theta = ((*a)[q][q] - (*a)[p][p]) / (2.0 * apq);
-    var t = Real(0.0);
-    if theta >= 0.0 {
-        t = 1.0 / (theta + sqrt(theta * theta + 1.0));
-    } else {
-        t = -1.0 / (-theta + sqrt(theta * theta + 1.0));
+    let d = (*a)[q][q] - (*a)[p][p];
+    let rho = sqrt(d * d + 4.0 * apq * apq);
+    let e = rho + abs(d);
+    if e <= 0.0 {
+        return;
     }
-    let c = 1.0 / sqrt(t * t + 1.0);
+    var t = -2.0 * apq / e;
+    if d >= 0.0 {
+        t = 2.0 * apq / e;
+    }
+    let c = sqrt(e / (2.0 * rho));
     let s = t * c;
     let r = 3u - p - q;
     let app = (*a)[p][p];
