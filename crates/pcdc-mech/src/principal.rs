@@ -30,8 +30,10 @@ pub struct Principal {
     pub axes: [[f64; 3]; 3],
 }
 
-/// Decomposes `t` (xx, yy, zz, xy, yz, xz) into principal values and axes. Components
-/// up to 1e150 in magnitude (a rotation squares them).
+/// Decomposes `t` (xx, yy, zz, xy, yz, xz) into principal values and axes, for
+/// components between about 1e-150 and 1e150 in magnitude: the sweeps' stop test and
+/// each rotation square them (beyond, the squares overflow or underflow and the sweeps
+/// stop early; stresses in Pa or in any engineering unit system are far inside).
 pub fn principal(t: &Sym6) -> Principal {
     let mut a = [[t[0], t[3], t[5]], [t[3], t[1], t[4]], [t[5], t[4], t[2]]];
     let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
