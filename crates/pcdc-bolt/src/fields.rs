@@ -46,3 +46,25 @@ pub const BOLT_BC_VELOCITY: FieldKey = FieldKey::new(
     Place::Set(BOLT_NODES),
     Components::Vector,
 );
+/// The host element of each bolt node (element index as a number): the element its
+/// grout pulls on, found in the reference mesh and re-found when the node leaves it
+/// (see the crate docs, "Re-locating"). Exact as a number up to 2²⁴ elements on an
+/// f32 GPU backend (the kernels do not read it back: it is output).
+pub const BOLT_HOST: FieldKey =
+    FieldKey::new("bolt_host", Place::Set(BOLT_NODES), Components::Fixed(1));
+/// Where each bolt node is grouted ([`anchor_len`] values per node): the index of its
+/// host within the node's candidate hosts, the barycentric weights of the grout point
+/// in the host (D + 1), the constant offset of the node from that point in the
+/// displacement form of the relative displacement (m, D), the distance along the axis
+/// (m) within which the node is surely still inside its host, and the node's axial
+/// displacement against the rock carried over from its earlier grout points (m: at each
+/// re-location the axial part of its relative displacement moves here, so that the
+/// grout's δ, force and slip go on unchanged). State of the bolts: read it for
+/// diagnostics, do not write it.
+pub const BOLT_ANCHOR: FieldKey =
+    FieldKey::new("bolt_anchor", Place::Set(BOLT_NODES), Components::Declared);
+
+/// Values per bolt node of [`BOLT_ANCHOR`] in `d` dimensions: 2d + 4.
+pub const fn anchor_len(d: usize) -> usize {
+    2 * d + 4
+}

@@ -1,7 +1,9 @@
 //! The GPU kernels of the bolts (`shaders/bolt.wgsl`), in the force phase: a segment
-//! pass (axial force, written per segment) and a node pass (each bolt node gathers its
-//! two segments' forces in a fixed order, adds the grout and plate, and writes its own
-//! slot and its host's slots): the CPU's arithmetic in the same order, no float
+//! pass (axial force, written per segment), a node pass (each bolt node gathers its two
+//! segments' forces in a fixed order, re-locates itself if it has left its host, adds
+//! the grout and plate, and writes its own slot and its grout vector) and a host pass
+//! (each element on a bolt's path sums the grout reactions of the nodes it hosts, in
+//! node order, into its slots): the CPU's arithmetic in the same order, no float
 //! atomics. Bolt-node conditions: one kernel per item, node forces in the force phase,
 //! velocities and accelerations after the velocity update, their tables evaluated on the
 //! host per step (signals) at the times the CPU uses.
@@ -19,9 +21,14 @@ use crate::{BoltBoundary, Bolts};
 /// `//!name` line.
 pub(crate) const BOLT_WGSL: &str = include_str!("shaders/bolt.wgsl");
 
-/// The source of kernel `name`: the shared head and that section.
+/// The source of kernel `name`: the shared head (segment state; not for the host pass,
+/// which needs none of its buffers) and that section.
 pub(crate) fn kernel_source(name: &str) -> String {
-    let head_end = BOLT_WGSL.find("//!").unwrap_or(BOLT_WGSL.len());
+    let head_end = if name == "host_kernel" {
+        0
+    } else {
+        BOLT_WGSL.find("//!").unwrap_or(BOLT_WGSL.len())
+    };
     let marker = format!("//!{name}\n");
     let body = BOLT_WGSL.find(&marker).map_or("", |at| {
         let start = at + marker.len();
@@ -65,28 +72,49 @@ pub(crate) fn bolts<D: Dim>(b: &Bolts, setup: &mut GpuSetup<'_, D>) -> Result<()
         ]);
         seg_real.extend_from_slice(&s.dx);
     }
-    let mut node_u = Vec::with_capacity(8 * b.nodes.len());
-    let mut node_r = Vec::with_capacity(14 * b.nodes.len());
-    for n in &b.nodes {
-        node_u.extend_from_slice(&[n.node, n.host, n.prev, n.next]);
-        node_u.extend_from_slice(&n.host_nodes);
-        node_r.extend_from_slice(&n.weights);
+    // Slots, bolt after bolt as registered: one per node, then D + 1 per path element.
+    let (mut node_slot, mut path_slot) = (Vec::new(), Vec::new());
+    let mut slot = 0u32;
+    for span in &b.spans {
+        node_slot.extend((0..span.nodes as u32).map(|i| slot + i));
+        slot += span.nodes as u32;
+        path_slot.extend((0..span.path as u32).map(|j| slot + j * (d as u32 + 1)));
+        slot += (span.path * (d + 1)) as u32;
+    }
+    let mut node_u = Vec::with_capacity(6 * b.nodes.len());
+    let mut node_r = Vec::with_capacity(10 * b.nodes.len());
+    for (n, s) in b.nodes.iter().zip(&node_slot) {
+        node_u.extend_from_slice(&[n.node, n.prev, n.next, n.cand[0], n.cand[1], *s]);
         node_r.extend_from_slice(&[n.k_axial, n.k_normal, n.bond_length, n.plate]);
         node_r.extend_from_slice(&n.bond);
+    }
+    let mut path_u = Vec::with_capacity(8 * b.path.len());
+    for (pe, s) in b.path.iter().zip(&path_slot) {
+        path_u.push(pe.element);
+        path_u.extend_from_slice(&pe.nodes);
+        path_u.extend_from_slice(&[pe.node_range[0], pe.node_range[1], *s]);
     }
     let seg_force = vec![0.0; 3 * b.segments.len()];
     let bs_nodes = setup.upload("bolt segment nodes", GpuData::U32(nonempty(seg_nodes)));
     let bs_real = setup.upload("bolt segment laws", GpuData::Real(nonempty(seg_real)));
     let bs_force = setup.upload("bolt segment forces", GpuData::Real(nonempty(seg_force)));
-    let bn_u32 = setup.upload("bolt node hosts", GpuData::U32(node_u));
+    let bn_u32 = setup.upload("bolt node data", GpuData::U32(node_u));
     let bn_real = setup.upload("bolt node grout", GpuData::Real(node_r));
+    let bp_u32 = setup.upload("bolt path elements", GpuData::U32(path_u));
+    let bn_grout = setup.upload(
+        "bolt node grout vectors",
+        GpuData::Real(vec![0.0; 3 * b.nodes.len()]),
+    );
     use Access::{Read as R, ReadWrite as W};
     let consts = |k: Kernel| {
         k.const_u32("D", d as u32)
             .const_u32("NSYM", D::NSYM as u32)
-            .const_u32("STRIDE", d as u32 + 2)
             .const_u32("NONE", NONE)
             .const_u32("BS_STRIDE", 9)
+            .const_u32("ALEN", crate::anchor_len(d) as u32)
+            .const_real("LEAVE", crate::walk::LEAVE)
+            .const_real("ENTER", crate::walk::ENTER)
+            .const_real("STRETCH", crate::walk::STRETCH)
     };
     let seg = consts(Kernel::new(
         "bolt segments",
@@ -114,6 +142,7 @@ pub(crate) fn bolts<D: Dim>(b: &Bolts, setup: &mut GpuSetup<'_, D>) -> Result<()
         "fn bolt_rotation(i: u32) -> Real { return 0.0; }\n"
     };
     let src = format!("{rotation}{}", kernel_source("node_kernel"));
+    let anchor = setup.field(BOLT_ANCHOR)?;
     let mut node = consts(Kernel::new("bolt nodes", src, b.nodes.len()))
         .const_u32("SLOT0", setup.slot_first())
         .bind("coords", setup.coords(), R)
@@ -123,14 +152,30 @@ pub(crate) fn bolts<D: Dim>(b: &Bolts, setup: &mut GpuSetup<'_, D>) -> Result<()
         .bind("bs_force", bs_force, R)
         .bind("bn_u32", bn_u32, R)
         .bind("bn_real", bn_real, R)
+        .bind("bp_u32", bp_u32, R)
         .bind("stress", setup.field(names::STRESS)?, R)
         .bind("bolt_slip", setup.field(BOLT_SLIP)?, W)
         .bind("bolt_grout_force", setup.field(BOLT_GROUT_FORCE)?, W)
+        .bind("bolt_anchor", anchor, W)
+        .bind("bolt_host", setup.field(BOLT_HOST)?, W)
+        .bind("bn_grout", bn_grout, W)
         .bind("slots", setup.slots(), W);
     if d == 3 {
         node = node.bind("rotation", setup.field(names::ROTATION)?, R);
     }
-    setup.kernel(Phase::Forces, node)
+    setup.kernel(Phase::Forces, node)?;
+    let hosts = consts(Kernel::new(
+        "bolt hosts",
+        kernel_source("host_kernel"),
+        b.path.len(),
+    ))
+    .const_u32("SLOT0", setup.slot_first())
+    .bind("bn_u32", bn_u32, R)
+    .bind("bp_u32", bp_u32, R)
+    .bind("bolt_anchor", anchor, R)
+    .bind("bn_grout", bn_grout, R)
+    .bind("slots", setup.slots(), W);
+    setup.kernel(Phase::Forces, hosts)
 }
 
 /// Node forces: every slot of the item gets the same force, component k from signal

@@ -39,6 +39,40 @@ pub fn barycentric(d: usize, x: &[f64], p: &[f64]) -> [f64; 4] {
     w
 }
 
+/// The smallest height of the simplex with vertices `x` (stride `d`): twice its area
+/// over its longest edge in 2D, three times its volume over its largest face in 3D (m).
+/// A point whose barycentric weights are all at least `w` stays inside the element
+/// while it moves less than `w` times this (each weight changes by at most the distance
+/// over the height above its vertex).
+pub fn min_height(d: usize, x: &[f64]) -> f64 {
+    let v = |q: usize, k: usize| x[d * q + k];
+    if d == 2 {
+        let det =
+            (v(1, 0) - v(0, 0)) * (v(2, 1) - v(0, 1)) - (v(2, 0) - v(0, 0)) * (v(1, 1) - v(0, 1));
+        let edge = |a: usize, b: usize| (v(a, 0) - v(b, 0)).hypot(v(a, 1) - v(b, 1));
+        det.abs() / edge(0, 1).max(edge(1, 2)).max(edge(0, 2))
+    } else {
+        let sub = |a: usize, b: usize| [v(a, 0) - v(b, 0), v(a, 1) - v(b, 1), v(a, 2) - v(b, 2)];
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let norm = |a: [f64; 3]| (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        let (e1, e2, e3) = (sub(1, 0), sub(2, 0), sub(3, 0));
+        let c = cross(e1, e2);
+        let vol6 = (c[0] * e3[0] + c[1] * e3[1] + c[2] * e3[2]).abs();
+        let faces = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]];
+        let area2 = faces
+            .iter()
+            .map(|f| norm(cross(sub(f[1], f[0]), sub(f[2], f[0]))))
+            .fold(0.0, f64::max);
+        vol6 / area2
+    }
+}
+
 /// The host of a point: element and weights of its `D + 1` nodes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Host {
@@ -104,6 +138,11 @@ impl<'a, D: Dim> Locator<'a, D> {
             loc.start.push(loc.items.len() as u32);
         }
         loc
+    }
+
+    /// The bucket size (m), about one element across.
+    pub(crate) fn cell(&self) -> f64 {
+        self.cell
     }
 
     fn cell_of(&self, v: f64, k: usize) -> usize {

@@ -77,18 +77,37 @@
 //! ```
 //!
 //! Fields (on the entity sets [`BOLT_SEGMENTS`] and [`BOLT_NODES`]): [`BOLT_AXIAL_FORCE`],
-//! [`BOLT_PLASTIC_ELONGATION`], [`BOLT_STATE`], [`BOLT_GROUT_FORCE`], [`BOLT_SLIP`].
+//! [`BOLT_PLASTIC_ELONGATION`], [`BOLT_STATE`], [`BOLT_GROUT_FORCE`], [`BOLT_SLIP`],
+//! [`BOLT_HOST`], [`BOLT_ANCHOR`].
 //! Output: [`output::BoltSeries`] writes the bolts as VTU line cells for ParaView,
 //! [`output::axial_force_profile`] gives the force along a bolt and
 //! [`output::AxialForceCsv`] writes its CSV history.
 //!
-//! On the GPU the bolts run as two force-phase kernels (segments, then nodes: each node
-//! gathers its two segments in a fixed order and writes its own and its host's slots),
-//! with the CPU's arithmetic in the same order and no float atomics.
+//! On the GPU the bolts run as three force-phase kernels (segments; nodes: each node
+//! gathers its two segments in a fixed order, re-locates if it must, and writes its own
+//! slot; hosts: each element on a path sums the reactions of the nodes it hosts), with
+//! the CPU's arithmetic in the same order and no float atomics.
 //!
-//! Not here: re-locating a bolt node whose host it has left: the host is found once, in
-//! the reference mesh, and its force slots are fixed there (the engine's gather is built
-//! once), so a node that slips further than its host element stays tied to it.
+//! # Re-locating
+//!
+//! A bolt node is grouted to a material point of its host, x_g = Σ_q w_q x_q, and its
+//! relative displacement is r = x_n − x_g. When the point the node has reached along
+//! the bolt, x_g + δ a, lies outside the host by more than 5 % of a weight (the host
+//! broke away and moved off, or the grout slipped past it), the node is re-found
+//! (\[NOT IN MANUAL\]: the manual grouts a node to "the element at its location" and
+//! says no more): among the elements its bolt's reference path crosses from two nodes
+//! before it to two nodes after it (two end-segment lengths beyond the head and the
+//! tail), the one holding that point best becomes its host, if it holds it to within
+//! 2.5 % of a weight, with that point as the new grout point. The lateral part of r is
+//! kept and the axial part is carried over ([`BOLT_ANCHOR`]), so the grout's δ, force
+//! and slip go on unchanged; [`BOLT_HOST`] names the host. Beyond that reach, or where
+//! no element holds the point (an open crack, the air outside a spalled face), the node
+//! stays with its last host. Each element on a bolt's path has force slots of its own,
+//! summing the reactions of the nodes it hosts in node order, so the engine's gather is
+//! fixed when the simulation is built and re-location needs no host round trip on the
+//! GPU. A node is checked only once its axial relative displacement exceeds the
+//! distance its weights allow (less than the smallest height, halved for the host's
+//! deformation), so nodes that stay put cost nothing.
 
 mod bolt;
 mod boundary;
@@ -98,13 +117,15 @@ mod gpu;
 mod host;
 mod material;
 pub mod output;
+mod path;
 mod physics;
+mod walk;
 
 pub use bolt::Bolt;
 pub use boundary::BoltNodes;
 pub use error::BoltError;
 pub use fields::*;
-pub use host::{barycentric, Host, Locator};
+pub use host::{barycentric, min_height, Host, Locator};
 pub use material::{grout_force, AxialLaw, BoltMaterial, BoltProperties, SegmentState};
 pub use physics::{BoltBoundary, Bolts};
 

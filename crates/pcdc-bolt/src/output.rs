@@ -24,7 +24,7 @@ fn sets<D: Dim>(
 }
 
 /// A `.pvd` series of the bolts: points are bolt nodes (grout force `grout_force` N,
-/// `slip` m), cells are segments (`axial_force` N, `plastic_elongation` m, `state`: 0
+/// `slip` m, `host_element`: the element the node is grouted to), cells are segments (`axial_force` N, `plastic_elongation` m, `state`: 0
 /// elastic, 1 yielded in tension, 2 in compression, 3 broken).
 pub struct BoltSeries {
     series: PvdSeries,
@@ -56,6 +56,7 @@ impl BoltSeries {
             cell_type: VTK_LINE,
         };
         let state: Vec<i32> = sim.field(BOLT_STATE)?.iter().map(|&s| s as i32).collect();
+        let host: Vec<i32> = sim.field(BOLT_HOST)?.iter().map(|&e| e as i32).collect();
         self.series.write_cells_step::<D>(
             sim.kinematics().time,
             &cells,
@@ -67,6 +68,10 @@ impl BoltSeries {
                 DataArray::Scalar {
                     name: "slip",
                     values: sim.field(BOLT_SLIP)?,
+                },
+                DataArray::Int {
+                    name: "host_element",
+                    values: &host,
                 },
             ],
             &[

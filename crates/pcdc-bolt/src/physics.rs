@@ -7,12 +7,13 @@ use pcdc_compute::{
     ForceContext, InitContext, KinematicNodes, Kinematics, Physics, StableStep, VelocityContext,
 };
 use pcdc_mesh::{Dim, Mesh};
-use rayon::prelude::*;
 
 use crate::boundary::{BcKind, BoltBc, BoltNodes, ResolvedBc};
 use crate::fields::*;
 use crate::host::Locator;
-use crate::material::{AxialLaw, SegmentState};
+use crate::material::AxialLaw;
+use crate::path::{self, PathElement};
+use crate::walk::{self, blocks, relative_disp, BLOCK_NODES, PARALLEL_FROM};
 use crate::{Bolt, BoltError, NAME};
 
 /// A segment: its two simulation nodes, reference length and law.
@@ -27,18 +28,15 @@ pub(crate) struct Segment {
     pub damping: f64,
 }
 
-/// A bolt node: its simulation node, host element and weights, the grout's stiffnesses
-/// over its tributary length, its bond factor, neighbouring segments and plate.
+/// A bolt node: its simulation node, candidate hosts, the grout's stiffnesses over its
+/// tributary length, its bond factor, neighbouring segments and plate. Its current host
+/// and grout point are state (the field [`BOLT_ANCHOR`]).
 #[derive(Clone, Debug)]
 pub(crate) struct BoltNode {
     pub node: u32,
-    pub bolt: u32,
-    pub host: u32,
-    pub host_nodes: [u32; 4],
-    pub weights: [f64; 4],
-    /// 2D: the adjugate of the host's reference edge matrix D_m (dm3, −dm1, −dm2, dm0),
-    /// so that D_x adj(D_m) = det(D_m) F gives the host's rotation without a division.
-    pub ref_adj: [f64; 4],
+    /// Its candidate hosts: `[first, end)` in [`Bolts::path`] (the elements its bolt's
+    /// path crosses between its neighbours; see `path.rs`).
+    pub cand: [u32; 2],
     /// K_b,r,s l (N/m), 0 on the free length.
     pub k_axial: f64,
     /// Lateral grout stiffness × l (N/m).
@@ -77,26 +75,52 @@ pub struct Bolts {
     bolts: Vec<Bolt>,
     pub(crate) segments: Vec<Segment>,
     pub(crate) nodes: Vec<BoltNode>,
+    /// The elements along every bolt's path, bolt after bolt: the candidate hosts, each
+    /// with force slots of its own.
+    pub(crate) path: Vec<PathElement>,
+    /// Nodes, segments and path elements of each bolt.
+    pub(crate) spans: Vec<Span>,
     /// First bolt-node and segment index of each bolt.
     node_offset: Vec<usize>,
     segment_offset: Vec<usize>,
-    ids: Option<Ids>,
-    /// Work blocks of whole bolts (first node and first segment of each; see
-    /// [`blocks`]): the unit of parallel work.
-    blocks: Vec<(usize, usize)>,
-    /// [`PARALLEL_FROM`] and [`BLOCK_NODES`] (tests vary them).
-    blocking: (usize, usize),
+    /// [`BOLT_ANCHOR`] and [`BOLT_HOST`] as found in the reference mesh.
+    anchor0: Vec<f64>,
+    host0: Vec<f64>,
+    pub(crate) ids: Option<Ids>,
+    /// The first bolt of each work block (see [`crate::walk::blocks`]): the unit of
+    /// parallel work.
+    pub(crate) blocks: Vec<usize>,
+    /// [`crate::walk::PARALLEL_FROM`] and [`crate::walk::BLOCK_NODES`] (tests vary them).
+    pub(crate) blocking: (usize, usize),
+}
+
+/// A bolt's share of the bolt nodes, segments and path elements. Its force slots: one per
+/// node, then `D + 1` per path element.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Span {
+    pub nodes: usize,
+    pub segments: usize,
+    pub path: usize,
+}
+
+impl Span {
+    /// Force slots of this bolt in `d` dimensions.
+    pub fn slots(&self, d: usize) -> usize {
+        self.nodes + self.path * (d + 1)
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
-struct Ids {
-    axial: FieldId,
-    plastic: FieldId,
-    state: FieldId,
-    grout: FieldId,
-    slip: FieldId,
-    stress: FieldId,
-    rotation: Option<FieldId>,
+pub(crate) struct Ids {
+    pub axial: FieldId,
+    pub plastic: FieldId,
+    pub state: FieldId,
+    pub grout: FieldId,
+    pub slip: FieldId,
+    pub anchor: FieldId,
+    pub host: FieldId,
+    pub stress: FieldId,
+    pub rotation: Option<FieldId>,
 }
 
 impl Default for Bolts {
@@ -112,8 +136,12 @@ impl Bolts {
             bolts: Vec::new(),
             segments: Vec::new(),
             nodes: Vec::new(),
+            path: Vec::new(),
+            spans: Vec::new(),
             node_offset: Vec::new(),
             segment_offset: Vec::new(),
+            anchor0: Vec::new(),
+            host0: Vec::new(),
             ids: None,
             blocks: Vec::new(),
             blocking: (PARALLEL_FROM, BLOCK_NODES),
@@ -171,17 +199,23 @@ impl Bolts {
         }
     }
 
-    /// Builds segments and nodes (hosts located in the reference mesh).
+    /// Builds segments, nodes and the paths' elements (hosts located in the reference
+    /// mesh).
     fn build<D: Dim>(&mut self, mesh: &Mesh<D>, first: usize) -> Result<(), BoltError> {
         let d = D::D;
         let two_d = d == 2;
         let locator = Locator::new(mesh);
         self.segments.clear();
         self.nodes.clear();
+        self.path.clear();
+        self.spans.clear();
         self.node_offset.clear();
         self.segment_offset.clear();
+        self.anchor0.clear();
+        self.host0.clear();
         let mut node = first as u32;
-        for (b, bolt) in self.bolts.iter().enumerate() {
+        let mut x = vec![0.0; (d + 1) * d];
+        for bolt in &self.bolts {
             let props = bolt.material().properties();
             if !two_d && props.spacing.is_some() {
                 return Err(BoltError::param(
@@ -193,6 +227,19 @@ impl Bolts {
             let eff = bolt.material().effective(two_d);
             let pts = bolt.points();
             let n = pts.len();
+            let route = path::bolt_path(&locator, pts).map_err(|k| BoltError::OutsideMesh {
+                bolt: bolt.name().to_string(),
+                node: k,
+                position: pts[k][..d].to_vec(),
+            })?;
+            let path0 = self.path.len();
+            self.path
+                .extend(route.elements.iter().map(|&e| path::path_element(mesh, e)));
+            self.spans.push(Span {
+                nodes: n,
+                segments: n - 1,
+                path: route.elements.len(),
+            });
             self.node_offset.push(self.nodes.len());
             self.segment_offset.push(self.segments.len());
             let seg0 = self.segments.len() as u32;
@@ -206,7 +253,7 @@ impl Bolts {
                 });
             }
             let free = bolt.free();
-            for (k, pt) in pts.iter().enumerate() {
+            for k in 0..n {
                 let lp = if k > 0 {
                     bolt.segment_length(k - 1)
                 } else {
@@ -219,31 +266,30 @@ impl Bolts {
                 };
                 let l = 0.5 * (lp + ln);
                 let grouted = free <= 0.0 || bolt.arc_length(k) >= free * (1.0 - 1e-9);
-                let host =
-                    locator
-                        .locate(&pt[..d], 1e-9)
-                        .ok_or_else(|| BoltError::OutsideMesh {
-                            bolt: bolt.name().to_string(),
-                            node: k,
-                            position: pt[..d].to_vec(),
-                        })?;
-                let mut host_nodes = [0u32; 4];
-                host_nodes[..=d].copy_from_slice(mesh.element(host.element));
-                let mut ref_adj = [0.0; 4];
-                if two_d {
-                    let x = |q: usize| mesh.node(host_nodes[q] as usize);
-                    let (x0, x1, x2) = (x(0), x(1), x(2));
-                    let dm = [x1[0] - x0[0], x2[0] - x0[0], x1[1] - x0[1], x2[1] - x0[1]];
-                    ref_adj = [dm[3], -dm[1], -dm[2], dm[0]];
+                let window = route.windows[k];
+                let (local, host) = route.hosts[k];
+                let index = self.nodes.len() as u32;
+                for pe in &mut self.path[path0 + window[0]..path0 + window[1]] {
+                    pe.node_range = [pe.node_range[0].min(index), pe.node_range[1].max(index + 1)];
                 }
+                // The grout point: the node itself in its host, no offset, and the
+                // distance it may move along the bolt before it could leave the host.
+                mesh.element_coords(host.element, &mut x);
+                let wmin = host.weights[..=d]
+                    .iter()
+                    .cloned()
+                    .fold(f64::INFINITY, f64::min);
+                self.anchor0.push((local - window[0]) as f64);
+                self.anchor0.extend_from_slice(&host.weights[..=d]);
+                self.anchor0.extend(std::iter::repeat_n(0.0, d));
+                self.anchor0
+                    .push(walk::margin(wmin, crate::host::min_height(d, &x)));
+                self.anchor0.push(0.0);
+                self.host0.push(host.element as f64);
                 let bond = bolt.material().bond_constants();
                 self.nodes.push(BoltNode {
                     node: node + k as u32,
-                    bolt: b as u32,
-                    host: host.element as u32,
-                    host_nodes,
-                    weights: host.weights,
-                    ref_adj,
+                    cand: [(path0 + window[0]) as u32, (path0 + window[1]) as u32],
                     k_axial: if grouted { eff.shear * l } else { 0.0 },
                     k_normal: eff.normal * l,
                     bond_length: l * eff.bond_per_spacing,
@@ -271,396 +317,6 @@ impl Bolts {
         let mid = bolt.arc_length(local) + 0.5 * bolt.segment_length(local);
         mid < bolt.free()
     }
-}
-
-/// Confining stress normal to the bolt at its host (Pa, ≥ 0, compression): the mean
-/// normal stress over the directions perpendicular to the axis `a` (global), from the
-/// host's co-rotated stress `s` (xx, yy, xy in 2D; xx, yy, zz, xy, yz, xz in 3D) and
-/// its rotation: in 2D `rot` = r (cos θ, sin θ) with any scale r ≠ 0 (see
-/// [`rotation_2d`]; the stress along the axis is quadratic in it and divided by r²), in
-/// 3D the mechanics' rotation matrix R (global = R σ Rᵀ).
-fn confinement(d: usize, s: &[f64], a: &[f64; 3], rot: &[f64]) -> f64 {
-    let (trace, saa) = if d == 2 {
-        let (mut c, mut sn) = (rot[0], rot[1]);
-        let mut r2 = c * c + sn * sn;
-        if r2 <= 0.0 {
-            (c, sn, r2) = (1.0, 0.0, 1.0);
-        }
-        // a_c = Rᵀ a with R = [[c, −s], [s, c]] (times r).
-        let ac = [c * a[0] + sn * a[1], -sn * a[0] + c * a[1]];
-        (
-            s[0] + s[1],
-            (ac[0] * ac[0] * s[0] + ac[1] * ac[1] * s[1] + 2.0 * ac[0] * ac[1] * s[2]) / r2,
-        )
-    } else {
-        let ac: [f64; 3] =
-            std::array::from_fn(|i| rot[i] * a[0] + rot[3 + i] * a[1] + rot[6 + i] * a[2]);
-        (
-            s[0] + s[1] + s[2],
-            ac[0] * ac[0] * s[0]
-                + ac[1] * ac[1] * s[1]
-                + ac[2] * ac[2] * s[2]
-                + 2.0 * (ac[0] * ac[1] * s[3] + ac[1] * ac[2] * s[4] + ac[0] * ac[2] * s[5]),
-        )
-    };
-    (-(trace - saa) / (d - 1) as f64).max(0.0)
-}
-
-/// The rotation of a triangle from its reference to its current positions `xc` (x, y
-/// of its three nodes) as r (cos θ, sin θ), θ the polar decomposition's angle of
-/// F = D_x D_m⁻¹, scaled by r = det(D_m) |…| (any sign): computed as D_x adj(D_m) with
-/// the adjugate `adj` of the reference edge matrix, so without a division (the
-/// confinement only needs the direction; this runs for every bolt node every step).
-fn rotation_2d(adj: &[f64; 4], xc: &[f64]) -> [f64; 2] {
-    let dx = [xc[2] - xc[0], xc[4] - xc[0], xc[3] - xc[1], xc[5] - xc[1]];
-    let f = [
-        dx[0] * adj[0] + dx[1] * adj[2],
-        dx[0] * adj[1] + dx[1] * adj[3],
-        dx[2] * adj[0] + dx[3] * adj[2],
-        dx[2] * adj[1] + dx[3] * adj[3],
-    ];
-    [f[0] + f[3], f[2] - f[1]]
-}
-
-/// Displacement of node `n` (m; z = 0 in 2D).
-fn disp<D: Dim>(kin: &Kinematics<'_, D>, n: u32) -> [f64; 3] {
-    let d = D::D;
-    let mut u = [0.0; 3];
-    u[..d].copy_from_slice(&kin.u[n as usize * d..n as usize * d + d]);
-    u
-}
-
-/// A segment's current unit direction and elongation L − L₀ (m), the latter as
-/// (2 ΔX·Δu + Δu·Δu) / (L + L₀) from the displacements, so that it keeps its digits
-/// where L − L₀ from positions would cancel (a stiff bar's force would carry E A / L₀
-/// times a rounding of the coordinates).
-fn segment_state<D: Dim>(seg: &Segment, kin: &Kinematics<'_, D>) -> ([f64; 3], f64) {
-    let (u0, u1) = (disp(kin, seg.n[0]), disp(kin, seg.n[1]));
-    let du = [u1[0] - u0[0], u1[1] - u0[1], u1[2] - u0[2]];
-    let x = &seg.dx;
-    let dv = [x[0] + du[0], x[1] + du[1], x[2] + du[2]];
-    let (e, l) = unit(dv);
-    let q = 2.0 * (x[0] * du[0] + x[1] * du[1] + x[2] * du[2])
-        + (du[0] * du[0] + du[1] * du[1] + du[2] * du[2]);
-    (e, q / (l + seg.l0))
-}
-
-/// Displacement of bolt node `n` relative to its host's material point,
-/// u_n − Σ_q w_q u_q (m): zero under any rigid motion, since the node sat at that point.
-fn relative_disp<D: Dim>(n: &BoltNode, kin: &Kinematics<'_, D>) -> [f64; 3] {
-    let mut r = disp(kin, n.node);
-    for q in 0..=D::D {
-        let u = disp(kin, n.host_nodes[q]);
-        (0..3).for_each(|k| r[k] -= n.weights[q] * u[k]);
-    }
-    r
-}
-
-fn unit(v: [f64; 3]) -> ([f64; 3], f64) {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    if l > 0.0 {
-        // One division, not three (per segment and bolt node every step).
-        let inv = 1.0 / l;
-        ([v[0] * inv, v[1] * inv, v[2] * inv], l)
-    } else {
-        ([0.0; 3], 0.0)
-    }
-}
-
-/// Bolt sets with fewer nodes than this run in one block on the calling thread. Measured
-/// on the FDEM tunnel bench (880 bolt nodes, about 20 µs of work per step, 2 threads):
-/// two halves in parallel were slower than one thread, the fork costing more than the
-/// work it shares.
-const PARALLEL_FROM: usize = 2048;
-
-/// Nodes per work block of a larger set (whole bolts, so a block may hold more): small
-/// enough that rayon's stealing balances the threads.
-const BLOCK_NODES: usize = 512;
-
-/// Groups whole bolts (given their first nodes and segments, and the node count) into
-/// work blocks: one below `parallel_from` nodes ([`PARALLEL_FROM`]), else blocks of at
-/// least `block_nodes` ([`BLOCK_NODES`]; the last may be smaller); returns each block's
-/// first node and first segment.
-fn blocks(
-    node_offset: &[usize],
-    segment_offset: &[usize],
-    n_nodes: usize,
-    (parallel_from, block_nodes): (usize, usize),
-) -> Vec<(usize, usize)> {
-    let size = if n_nodes < parallel_from {
-        usize::MAX
-    } else {
-        block_nodes
-    };
-    let mut out: Vec<(usize, usize)> = Vec::new();
-    let mut last = None;
-    for (&n, &s) in node_offset.iter().zip(segment_offset) {
-        if last.is_none_or(|l| n - l >= size) {
-            out.push((n, s));
-            last = Some(n);
-        }
-    }
-    out
-}
-
-/// A segment's force vector on its end node's side (N: f e with f the axial force plus
-/// damping) and its current unit direction e.
-type SegmentOut = ([f64; 3], [f64; 3]);
-
-/// What the walk reads besides the kinematics: the host stresses (and rotations in 3D).
-struct Walk<'a> {
-    stress: &'a [f64],
-    rotation: &'a [f64],
-}
-
-/// A block of whole bolts and the entries it writes: its segments' axial force, plastic
-/// elongation and state, its nodes' grout force and slip and force slots.
-struct Block<'a> {
-    first_segment: usize,
-    segments: &'a [Segment],
-    nodes: &'a [BoltNode],
-    axial: &'a mut [f64],
-    plastic: &'a mut [f64],
-    state: &'a mut [f64],
-    grout: &'a mut [f64],
-    slip: &'a mut [f64],
-    slots: &'a mut [f64],
-}
-
-impl Walk<'_> {
-    /// Walks every bolt of `b` from head to toe: at each node, the segment starting
-    /// there (axial force, eq. 138-142, plus damping, eq. 148), then the node with the
-    /// segments before and after it. Each segment is computed once; every entry is
-    /// written by one node or segment only (deterministic in any block split).
-    fn block<D: Dim>(&self, b: Block<'_>, kin: &Kinematics<'_, D>) {
-        let stride = (D::D + 2) * D::D;
-        let mut prev: Option<SegmentOut> = None;
-        for (i, n) in b.nodes.iter().enumerate() {
-            let next = (n.next != NONE).then(|| {
-                let s = n.next as usize - b.first_segment;
-                segment(
-                    &b.segments[s],
-                    kin,
-                    &mut b.axial[s],
-                    &mut b.plastic[s],
-                    &mut b.state[s],
-                )
-            });
-            // A bolt's first node has no previous segment (`prev` then holds the last
-            // segment of the bolt before, unused).
-            let before = if n.prev != NONE { prev.as_ref() } else { None };
-            self.node(
-                n,
-                before,
-                next.as_ref(),
-                kin,
-                &mut b.slots[i * stride..(i + 1) * stride],
-                &mut b.grout[i],
-                &mut b.slip[i],
-            );
-            prev = next;
-        }
-    }
-
-    /// One bolt node: its bar forces (previous then next segment), the grout against its
-    /// host with the host's confinement, the lateral grout and the face plate; writes its
-    /// slot and its host's `D + 1` slots (`slots`), its grout force and slip.
-    #[allow(clippy::too_many_arguments)]
-    fn node<D: Dim>(
-        &self,
-        n: &BoltNode,
-        prev: Option<&SegmentOut>,
-        next: Option<&SegmentOut>,
-        kin: &Kinematics<'_, D>,
-        slots: &mut [f64],
-        grout: &mut f64,
-        slip: &mut f64,
-    ) {
-        let d = D::D;
-        // Bar forces on the node: +f e as the start of the next segment, −f e as the
-        // end of the previous one (fixed order: previous, next).
-        let mut f = [0.0; 3];
-        if let Some((g, _)) = prev {
-            (0..3).for_each(|k| f[k] -= g[k]);
-        }
-        if let Some((g, _)) = next {
-            (0..3).for_each(|k| f[k] += g[k]);
-        }
-        // Axis at the node: mean of the adjacent segments' current directions.
-        let mut axis = [0.0; 3];
-        for (_, e) in [prev, next].into_iter().flatten() {
-            (0..3).for_each(|k| axis[k] += e[k]);
-        }
-        let (a, _) = unit(axis);
-        // Against the host's material point where the node was grouted.
-        let r = relative_disp(n, kin);
-        let delta = r[0] * a[0] + r[1] * a[1] + r[2] * a[2];
-        // Grout along the axis: bond-slip with the host's confinement.
-        let mut fs = 0.0;
-        let trial = n.k_axial * (delta - *slip);
-        if n.k_axial > 0.0 && trial.abs() <= n.cap_unconfined {
-            // Elastic under any confinement: the same force and slip as below, exactly.
-            fs = trial;
-        } else if n.k_axial > 0.0 {
-            let e = n.host as usize;
-            let mut rot = [0.0; 9];
-            if d == 2 {
-                let mut xc = [0.0; 6];
-                for q in 0..3 {
-                    let p = kin.position(n.host_nodes[q] as usize);
-                    xc[2 * q..2 * q + 2].copy_from_slice(&p[..2]);
-                }
-                rot[..2].copy_from_slice(&rotation_2d(&n.ref_adj, &xc));
-            } else {
-                rot.copy_from_slice(&self.rotation[9 * e..9 * e + 9]);
-            }
-            let nsym = D::NSYM;
-            let sn = confinement(d, &self.stress[nsym * e..nsym * (e + 1)], &a, &rot);
-            let cap = crate::material::bond_strength(&n.bond, sn) * n.bond_length;
-            let (force, s) = crate::material::grout_force(delta, *slip, n.k_axial, cap);
-            fs = force;
-            *slip = s;
-        }
-        *grout = fs;
-        // Lateral grout, and the face plate (one-sided, pushes the head back out).
-        let mut g: [f64; 3] =
-            std::array::from_fn(|k| fs * a[k] + n.k_normal * (r[k] - delta * a[k]));
-        if n.plate > 0.0 && delta > 0.0 {
-            (0..3).for_each(|k| g[k] += n.plate * delta * a[k]);
-        }
-        for k in 0..d {
-            slots[k] = f[k] - g[k];
-        }
-        for q in 0..=d {
-            let o = (q + 1) * d;
-            for (k, gk) in g.iter().enumerate().take(d) {
-                slots[o + k] = n.weights[q] * gk;
-            }
-        }
-    }
-}
-
-/// One segment: the axial force in total form from its elongation (eq. 138-142) into
-/// `axial`, `plastic`, `state`, plus damping on the relative axial velocity (eq. 148).
-fn segment<D: Dim>(
-    seg: &Segment,
-    kin: &Kinematics<'_, D>,
-    axial: &mut f64,
-    plastic: &mut f64,
-    state: &mut f64,
-) -> SegmentOut {
-    let d = D::D;
-    let (e, elongation) = segment_state(seg, kin);
-    let broken = SegmentState::from_value(*state) == SegmentState::Broken;
-    let (f, up, st) = seg.law.update(elongation, seg.l0, *plastic, broken);
-    *axial = f;
-    *plastic = up;
-    *state = st as i32 as f64;
-    let mut total = f;
-    if seg.damping > 0.0 && st != SegmentState::Broken {
-        let (a, b) = (seg.n[0] as usize * d, seg.n[1] as usize * d);
-        let rel: f64 = (0..d).map(|k| (kin.v[b + k] - kin.v[a + k]) * e[k]).sum();
-        total += seg.damping * rel;
-    }
-    ([total * e[0], total * e[1], total * e[2]], e)
-}
-
-impl Bolts {
-    /// Every bolt's segments and nodes in one walk per block (see [`Walk::block`]);
-    /// blocks run in parallel when there are several.
-    fn walk<D: Dim>(&mut self, ctx: &mut ForceContext<'_, D>) -> Result<(), ComputeError> {
-        let d = D::D;
-        let ids = self.ids.expect("init ran");
-        let kin = &ctx.kin;
-        // The host's stress (and rotation in 3D) are read in place.
-        let ([axial, plastic, state, grout, slip], stress, rotation) = if let Some(r) = ids.rotation
-        {
-            let [a, p, st, g, sl, stress, rot] = ctx.fields.get_many_mut([
-                ids.axial,
-                ids.plastic,
-                ids.state,
-                ids.grout,
-                ids.slip,
-                ids.stress,
-                r,
-            ]);
-            ([a, p, st, g, sl], &*stress, &*rot)
-        } else {
-            let [a, p, st, g, sl, stress] = ctx.fields.get_many_mut([
-                ids.axial,
-                ids.plastic,
-                ids.state,
-                ids.grout,
-                ids.slip,
-                ids.stress,
-            ]);
-            ([a, p, st, g, sl], &*stress, &[][..])
-        };
-        let walk = Walk { stress, rotation };
-        let whole = Block {
-            first_segment: 0,
-            segments: &self.segments,
-            nodes: &self.nodes,
-            axial,
-            plastic,
-            state,
-            grout,
-            slip,
-            slots: ctx.slots,
-        };
-        if self.blocks.len() <= 1 {
-            walk.block(whole, kin);
-        } else {
-            split_blocks(whole, &self.blocks, (d + 2) * d)
-                .into_par_iter()
-                .for_each(|b| walk.block(b, kin));
-        }
-        Ok(())
-    }
-}
-
-/// Cuts `whole` at the blocks' first nodes and segments (`stride` slot values per node).
-fn split_blocks<'a>(
-    mut rest: Block<'a>,
-    blocks: &[(usize, usize)],
-    stride: usize,
-) -> Vec<Block<'a>> {
-    let mut out = Vec::with_capacity(blocks.len());
-    for w in blocks.windows(2) {
-        let (n, s) = (w[1].0 - w[0].0, w[1].1 - w[0].1);
-        let (axial, axial_r) = std::mem::take(&mut rest.axial).split_at_mut(s);
-        let (plastic, plastic_r) = std::mem::take(&mut rest.plastic).split_at_mut(s);
-        let (state, state_r) = std::mem::take(&mut rest.state).split_at_mut(s);
-        let (grout, grout_r) = std::mem::take(&mut rest.grout).split_at_mut(n);
-        let (slip, slip_r) = std::mem::take(&mut rest.slip).split_at_mut(n);
-        let (slots, slots_r) = std::mem::take(&mut rest.slots).split_at_mut(n * stride);
-        let (segments, segments_r) = rest.segments.split_at(s);
-        let (nodes, nodes_r) = rest.nodes.split_at(n);
-        out.push(Block {
-            first_segment: w[0].1,
-            segments,
-            nodes,
-            axial,
-            plastic,
-            state,
-            grout,
-            slip,
-            slots,
-        });
-        rest = Block {
-            first_segment: w[1].1,
-            segments: segments_r,
-            nodes: nodes_r,
-            axial: axial_r,
-            plastic: plastic_r,
-            state: state_r,
-            grout: grout_r,
-            slip: slip_r,
-            slots: slots_r,
-        };
-    }
-    out.push(rest);
-    out
 }
 
 impl<D: Dim> Physics<D> for Bolts {
@@ -694,6 +350,8 @@ impl<D: Dim> Physics<D> for Bolts {
             BOLT_STATE.own::<D>(),
             BOLT_GROUT_FORCE.own::<D>(),
             BOLT_SLIP.own::<D>(),
+            BOLT_ANCHOR.own_sized::<D>(anchor_len(D::D)),
+            BOLT_HOST.own::<D>(),
             names::STRESS.read_lagged::<D>(),
         ];
         if D::D == 3 {
@@ -722,11 +380,16 @@ impl<D: Dim> Physics<D> for Bolts {
         let mass: Vec<f64> = self.nodes.iter().map(|n| n.mass).collect();
         let block = ctx.add_nodes(&coords, &mass)?;
         debug_assert_eq!(block.first, first);
-        // Slots: per bolt node, the node itself then its host's nodes.
-        let mut slot_nodes = Vec::with_capacity(self.nodes.len() * (d + 2));
-        for n in &self.nodes {
-            slot_nodes.push(n.node);
-            slot_nodes.extend_from_slice(&n.host_nodes[..=d]);
+        // Slots, bolt after bolt: one per bolt node, then the D + 1 nodes of each element
+        // on its path (the grout reactions of the nodes it hosts, summed in node order).
+        let mut slot_nodes = Vec::new();
+        let (mut i, mut j) = (0, 0);
+        for span in &self.spans {
+            slot_nodes.extend(self.nodes[i..i + span.nodes].iter().map(|n| n.node));
+            for pe in &self.path[j..j + span.path] {
+                slot_nodes.extend_from_slice(&pe.nodes[..=d]);
+            }
+            (i, j) = (i + span.nodes, j + span.path);
         }
         ctx.register_slots(&slot_nodes)?;
         let ids = Ids {
@@ -735,6 +398,8 @@ impl<D: Dim> Physics<D> for Bolts {
             state: ctx.fields.id(BOLT_STATE)?,
             grout: ctx.fields.id(BOLT_GROUT_FORCE)?,
             slip: ctx.fields.id(BOLT_SLIP)?,
+            anchor: ctx.fields.id(BOLT_ANCHOR)?,
+            host: ctx.fields.id(BOLT_HOST)?,
             stress: ctx.fields.id(names::STRESS)?,
             rotation: if d == 3 {
                 Some(ctx.fields.id(names::ROTATION)?)
@@ -754,17 +419,16 @@ impl<D: Dim> Physics<D> for Bolts {
             }
         }
         ctx.fields.get_mut(ids.plastic).copy_from_slice(&plastic);
+        ctx.fields
+            .get_mut(ids.anchor)
+            .copy_from_slice(&self.anchor0);
+        ctx.fields.get_mut(ids.host).copy_from_slice(&self.host0);
         self.ids = Some(ids);
-        self.blocks = blocks(
-            &self.node_offset,
-            &self.segment_offset,
-            self.nodes.len(),
-            self.blocking,
-        );
+        self.blocks = blocks(&self.spans, self.blocking);
         Ok(())
     }
 
-    fn add_mass(&self, _mesh: &Mesh<D>, _f: &FieldStore, mass: &mut [f64], scale: Option<f64>) {
+    fn add_mass(&self, _mesh: &Mesh<D>, f: &FieldStore, mass: &mut [f64], scale: Option<f64>) {
         // Physical masses came with the nodes (InitContext::add_nodes). For static
         // relaxation's mass scaling (critical step `t` everywhere): each bolt node gets
         // m = S t² / 4 with S its Gershgorin row sum, and each host node the row sum the
@@ -775,7 +439,12 @@ impl<D: Dim> Physics<D> for Bolts {
         let Some(t) = scale else { return };
         let q = 2.0 * t * t / 4.0;
         let d = D::D;
-        for n in &self.nodes {
+        let alen = anchor_len(d);
+        // The current hosts (those found in the reference mesh before init).
+        let anchor = self.ids.map_or(&self.anchor0[..], |ids| f.get(ids.anchor));
+        for (i, n) in self.nodes.iter().enumerate() {
+            let a = &anchor[i * alen..(i + 1) * alen];
+            let host = &self.path[n.cand[0] as usize + a[0] as usize];
             let k = n.k_axial.max(n.k_normal) + n.plate;
             let mut s = k;
             for seg in [n.prev, n.next] {
@@ -785,8 +454,8 @@ impl<D: Dim> Physics<D> for Bolts {
                 }
             }
             mass[n.node as usize] += s * q;
-            for a in 0..=d {
-                mass[n.host_nodes[a] as usize] += 2.0 * k * n.weights[a].abs() * q;
+            for q_ in 0..=d {
+                mass[host.nodes[q_] as usize] += 2.0 * k * a[1 + q_].abs() * q;
             }
         }
     }
@@ -840,6 +509,8 @@ impl<D: Dim> Physics<D> for Bolts {
         let Some(ids) = self.ids else { return 0.0 };
         let axial = fields.get(ids.axial);
         let grout = fields.get(ids.grout);
+        let anchor = fields.get(ids.anchor);
+        let alen = anchor_len(D::D);
         let mut e = 0.0;
         for (s, seg) in self.segments.iter().enumerate() {
             e += 0.5 * axial[s] * axial[s] * seg.l0 / seg.law.ea;
@@ -848,7 +519,9 @@ impl<D: Dim> Physics<D> for Bolts {
             if n.k_axial > 0.0 {
                 e += 0.5 * grout[i] * grout[i] / n.k_axial;
             }
-            let r = relative_disp(n, kin);
+            let a = &anchor[i * alen..(i + 1) * alen];
+            let host = &self.path[n.cand[0] as usize + a[0] as usize];
+            let r = relative_disp(n.node, host, a, kin);
             e += 0.5 * n.k_normal * (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
         }
         e
@@ -864,6 +537,32 @@ impl<D: Dim> Physics<D> for Bolts {
             return Err(ComputeError::SnapshotCorrupt(format!(
                 "bolt segment state {v} is not one of 0, 1, 2, 3"
             )));
+        }
+        // The grout points: a candidate index in range (the step indexes with it), finite
+        // weights, offsets and margins, and the host element that index names.
+        let d = D::D;
+        let alen = anchor_len(d);
+        let (anchor, host) = (fields.get(ids.anchor), fields.get(ids.host));
+        for (i, n) in self.nodes.iter().enumerate() {
+            let a = &anchor[i * alen..(i + 1) * alen];
+            let count = (n.cand[1] - n.cand[0]) as f64;
+            let bad = if !(a[0] >= 0.0 && a[0] < count && a[0].fract() == 0.0) {
+                Some(format!("candidate host {} of {count}", a[0]))
+            } else if a.iter().any(|v| !v.is_finite()) || a[2 * d + 2] < 0.0 {
+                Some("a weight, offset or margin that is not finite or a negative margin".into())
+            } else if host[i] != self.path[n.cand[0] as usize + a[0] as usize].element as f64 {
+                Some(format!(
+                    "host element {} that is not its candidate's",
+                    host[i]
+                ))
+            } else {
+                None
+            };
+            if let Some(why) = bad {
+                return Err(ComputeError::SnapshotCorrupt(format!(
+                    "bolt node {i} has {why}"
+                )));
+            }
         }
         Ok(())
     }
@@ -885,11 +584,24 @@ impl<D: Dim> Physics<D> for Bolts {
     }
 
     fn slot_entity(&self, slot: usize) -> Option<String> {
-        // Slots per bolt node: the node, then its host's D + 1 nodes.
-        let n = self.nodes.get(slot / (D::D + 2))?;
-        let b = &self.bolts[n.bolt as usize];
-        let k = n.node as usize - self.nodes[self.node_offset[n.bolt as usize]].node as usize;
-        Some(format!("bolt '{}' node {k}", b.name()))
+        // Bolt after bolt: one slot per node, then D + 1 per path element.
+        let d = D::D;
+        let mut first = 0;
+        for (b, span) in self.spans.iter().enumerate() {
+            let local = slot.checked_sub(first)?;
+            if local < span.slots(d) {
+                let name = self.bolts[b].name();
+                return Some(if local < span.nodes {
+                    format!("bolt '{name}' node {local}")
+                } else {
+                    let pe = &self.path[self.spans[..b].iter().map(|s| s.path).sum::<usize>()
+                        + (local - span.nodes) / (d + 1)];
+                    format!("bolt '{name}' grout on element {}", pe.element)
+                });
+            }
+            first += span.slots(d);
+        }
+        None
     }
 }
 
@@ -1119,14 +831,21 @@ mod tests {
     #[test]
     fn blocks_hold_whole_bolts_and_start_parallel_work_at_the_threshold() {
         // Bolts of 3, 5, 3, 4 nodes (2, 4, 2, 3 segments).
-        let (nodes, segs) = ([0, 3, 8, 11], [0, 2, 6, 8]);
-        assert_eq!(blocks(&nodes, &segs, 15, (16, 4)), vec![(0, 0)]);
+        let spans: Vec<Span> = [3, 5, 3, 4]
+            .iter()
+            .map(|&n| Span {
+                nodes: n,
+                segments: n - 1,
+                path: n,
+            })
+            .collect();
+        assert_eq!(blocks(&spans, (16, 4)), vec![0]);
         assert_eq!(
-            blocks(&nodes, &segs, 15, (15, 4)),
-            vec![(0, 0), (8, 6)],
+            blocks(&spans, (15, 4)),
+            vec![0, 2],
             "whole bolts of at least 4 nodes"
         );
-        assert_eq!(blocks(&nodes, &segs, 15, (1, 1)).len(), 4);
+        assert_eq!(blocks(&spans, (1, 1)).len(), 4);
     }
 
     /// A plate under gravity with 60 pretensioned, plated bolts, run with `blocking`.

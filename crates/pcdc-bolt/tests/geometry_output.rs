@@ -63,6 +63,7 @@ fn bolts_are_written_as_vtu_lines_and_csv_histories() {
         "axial_force",
         "grout_force",
         "slip",
+        "host_element",
         "state",
         "NumberOfCells=\"6\"",
     ] {

@@ -160,10 +160,10 @@ fn bolt_wgsl_validates_with_naga() {
             .unwrap(),
         );
         let bolt: Vec<_> = all.iter().filter(|(l, _)| l.starts_with("bolt")).collect();
-        // Segments, nodes, and three conditions, in 2D and 3D.
+        // Segments, nodes, hosts, and three conditions, in 2D and 3D.
         assert_eq!(
             bolt.len(),
-            10,
+            12,
             "{:?}",
             bolt.iter().map(|b| &b.0).collect::<Vec<_>>()
         );

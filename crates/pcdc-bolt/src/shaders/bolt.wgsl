@@ -1,14 +1,19 @@
 // Rock bolts (manual 7.9) on the GPU: the same arithmetic, in the same order, as the CPU
-// path of pcdc-bolt (`physics.rs`, `material.rs`). A shared head, then one section per
-// kernel after a marker line (two slashes, a bang and its name): `segment_kernel` (axial force per segment), then
-// `node_kernel` (bar forces gathered from the node's two segments in a fixed order,
-// grout against the host, face plate; writes the node's slot and its host's slots).
+// path of pcdc-bolt (`walk.rs`, `material.rs`). A shared head, then one section per
+// kernel after a marker line (two slashes, a bang and its name): `segment_kernel` (axial
+// force per segment), `node_kernel` (bar forces gathered from the node's two segments in
+// a fixed order, re-location, grout against the host, face plate; writes the node's slot
+// and its grout vector), then `host_kernel` (per element on a bolt's path: the grout
+// reactions of the bolt nodes it hosts, in node order, into its slots).
 //
-// Consts: D, NSYM, STRIDE (slots per bolt node, D + 2), SLOT0 (first slot), NONE.
+// Consts: D, NSYM, SLOT0 (first slot), NONE, ALEN (2D + 3 values of bolt_anchor per node).
 // bs_nodes: 2 nodes per segment; bs_real (BS_STRIDE = 9 per segment): l0, EA, f_t, f_c,
 // ε_f, damping, reference vector ΔX;
-// bn_u32: node, host, prev, next, 4 host nodes per bolt node; bn_real (14 per node): 4 weights, k_axial,
-// k_normal, bond length, plate, 6 bond constants per bolt node.
+// bn_u32 (6 per bolt node): node, prev, next, first and end candidate (path index), slot;
+// bn_real (10 per node): k_axial, k_normal, bond length, plate, 6 bond constants;
+// bp_u32 (8 per path element): element, 4 nodes, first and end bolt node hosted, slot;
+// bolt_anchor (ALEN per node): candidate index, D + 1 weights, D offsets, margin, axial
+// displacement carried over.
 
 // Unit vector and length of v (zero vector and 0 for a zero v).
 fn unit4(v: array<Real, 3>) -> array<Real, 4> {
@@ -99,6 +104,171 @@ fn position(n: u32) -> array<Real, 3> {
     return p;
 }
 
+fn path_nodes(j: u32) -> array<u32, 4> {
+    return array<u32, 4>(bp_u32[8u * j + 1u], bp_u32[8u * j + 2u], bp_u32[8u * j + 3u],
+        bp_u32[8u * j + 4u]);
+}
+
+// Current positions of a path element's D + 1 nodes (stride D).
+fn element_positions(h: array<u32, 4>) -> array<Real, 12> {
+    var x: array<Real, 12>;
+    for (var q = 0u; q <= D; q = q + 1u) {
+        let p = position(h[q]);
+        for (var k = 0u; k < D; k = k + 1u) {
+            x[q * D + k] = p[k];
+        }
+    }
+    return x;
+}
+
+fn det3(a: array<Real, 3>, b: array<Real, 3>, c: array<Real, 3>) -> Real {
+    return a[0] * (b[1] * c[2] - b[2] * c[1]) - b[0] * (a[1] * c[2] - a[2] * c[1])
+        + c[0] * (a[1] * b[2] - a[2] * b[1]);
+}
+
+// Barycentric coordinates of p in the simplex x (as `host::barycentric`).
+fn barycentric(x: array<Real, 12>, p: array<Real, 3>) -> array<Real, 4> {
+    var w = array<Real, 4>(0.0, 0.0, 0.0, 0.0);
+    if D == 2u {
+        let a = x[2] - x[0];
+        let b = x[4] - x[0];
+        let c = x[3] - x[1];
+        let e = x[5] - x[1];
+        let det = a * e - b * c;
+        let px = p[0] - x[0];
+        let py = p[1] - x[1];
+        w[1] = (e * px - b * py) / det;
+        w[2] = (a * py - c * px) / det;
+        w[0] = 1.0 - w[1] - w[2];
+    } else {
+        let c1 = array<Real, 3>(x[3] - x[0], x[4] - x[1], x[5] - x[2]);
+        let c2 = array<Real, 3>(x[6] - x[0], x[7] - x[1], x[8] - x[2]);
+        let c3 = array<Real, 3>(x[9] - x[0], x[10] - x[1], x[11] - x[2]);
+        let r = array<Real, 3>(p[0] - x[0], p[1] - x[1], p[2] - x[2]);
+        let det = det3(c1, c2, c3);
+        w[1] = det3(r, c2, c3) / det;
+        w[2] = det3(c1, r, c3) / det;
+        w[3] = det3(c1, c2, r) / det;
+        w[0] = 1.0 - w[1] - w[2] - w[3];
+    }
+    return w;
+}
+
+fn smallest(w: array<Real, 4>) -> Real {
+    var m = w[0];
+    for (var q = 1u; q <= D; q = q + 1u) {
+        m = min(m, w[q]);
+    }
+    return m;
+}
+
+fn sub3(x: array<Real, 12>, a: u32, b: u32) -> array<Real, 3> {
+    return array<Real, 3>(x[3u * a] - x[3u * b], x[3u * a + 1u] - x[3u * b + 1u],
+        x[3u * a + 2u] - x[3u * b + 2u]);
+}
+
+fn cross_norm(a: array<Real, 3>, b: array<Real, 3>) -> Real {
+    let c0 = a[1] * b[2] - a[2] * b[1];
+    let c1 = a[2] * b[0] - a[0] * b[2];
+    let c2 = a[0] * b[1] - a[1] * b[0];
+    return sqrt(c0 * c0 + c1 * c1 + c2 * c2);
+}
+
+// The smallest height of the simplex x (as `host::min_height`).
+fn min_height(x: array<Real, 12>) -> Real {
+    if D == 2u {
+        let det = (x[2] - x[0]) * (x[5] - x[1]) - (x[4] - x[0]) * (x[3] - x[1]);
+        let e01 = sqrt((x[0] - x[2]) * (x[0] - x[2]) + (x[1] - x[3]) * (x[1] - x[3]));
+        let e12 = sqrt((x[2] - x[4]) * (x[2] - x[4]) + (x[3] - x[5]) * (x[3] - x[5]));
+        let e02 = sqrt((x[0] - x[4]) * (x[0] - x[4]) + (x[1] - x[5]) * (x[1] - x[5]));
+        return abs(det) / max(max(e01, e12), e02);
+    }
+    let e1 = sub3(x, 1u, 0u);
+    let e2 = sub3(x, 2u, 0u);
+    let e3 = sub3(x, 3u, 0u);
+    let vol6 = abs(det3(e3, e1, e2));
+    var area2 = cross_norm(e1, e2);
+    area2 = max(area2, cross_norm(e1, e3));
+    area2 = max(area2, cross_norm(e2, e3));
+    area2 = max(area2, cross_norm(sub3(x, 2u, 1u), sub3(x, 3u, 1u)));
+    return vol6 / area2;
+}
+
+// As `walk::margin`.
+fn margin(wmin: Real, h: Real) -> Real {
+    return max((wmin + LEAVE) * h / STRETCH, 0.0);
+}
+
+// Node displacement relative to its grout point (as `walk::relative_disp`).
+fn relative_disp(node: u32, j: u32, a0: u32) -> array<Real, 3> {
+    var r = displacement(node);
+    for (var k = 0u; k < D; k = k + 1u) {
+        r[k] = r[k] + bolt_anchor[a0 + D + 2u + k];
+    }
+    let h = path_nodes(j);
+    for (var q = 0u; q <= D; q = q + 1u) {
+        let u = displacement(h[q]);
+        let w = bolt_anchor[a0 + 1u + q];
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            r[k] = r[k] - w * u[k];
+        }
+    }
+    return r;
+}
+
+// As `walk::relocate`: the new host's path index (anchor written), or NONE.
+fn relocate(node: u32, c0: u32, c1: u32, a0: u32, a: array<Real, 4>, r: array<Real, 3>,
+        delta: Real) -> u32 {
+    let own = c0 + u32(bolt_anchor[a0]);
+    let xn = position(node);
+    var lateral: array<Real, 3>;
+    var p: array<Real, 3>;
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        lateral[k] = r[k] - delta * a[k];
+        p[k] = xn[k] - lateral[k];
+    }
+    if smallest(barycentric(element_positions(path_nodes(own)), p)) >= -LEAVE {
+        return NONE;
+    }
+    var best = NONE;
+    var best_m: Real = 0.0;
+    var best_w: array<Real, 4>;
+    var best_x: array<Real, 12>;
+    for (var j = c0; j < c1; j = j + 1u) {
+        if j == own {
+            continue;
+        }
+        let x = element_positions(path_nodes(j));
+        let w = barycentric(x, p);
+        let m = smallest(w);
+        if best == NONE || m > best_m {
+            best = j;
+            best_m = m;
+            best_w = w;
+            best_x = x;
+        }
+    }
+    if best == NONE || !(best_m >= -ENTER) {
+        return NONE;
+    }
+    let un = displacement(node);
+    let h = path_nodes(best);
+    bolt_anchor[a0] = Real(best - c0);
+    for (var q = 0u; q <= D; q = q + 1u) {
+        bolt_anchor[a0 + 1u + q] = best_w[q];
+    }
+    for (var k = 0u; k < D; k = k + 1u) {
+        var v = un[k];
+        for (var q = 0u; q <= D; q = q + 1u) {
+            let u = displacement(h[q]);
+            v = v - best_w[q] * u[k];
+        }
+        bolt_anchor[a0 + D + 2u + k] = lateral[k] - v;
+    }
+    bolt_anchor[a0 + 2u * D + 2u] = margin(best_m, min_height(best_x));
+    return best;
+}
+
 // Rotation of a triangle from its reference to its current positions as r (cos, sin),
 // r = det(Dm) |..| of any sign: Dx adj(Dm), without a division (as on the CPU).
 fn rotation_2d(h: array<u32, 4>) -> array<Real, 2> {
@@ -168,18 +338,17 @@ fn confinement(e: u32, a: array<Real, 4>, h: array<u32, 4>) -> Real {
 }
 
 fn kernel(i: u32) {
-    let node = bn_u32[8u * i];
-    let host = bn_u32[8u * i + 1u];
-    let prev = bn_u32[8u * i + 2u];
-    let next = bn_u32[8u * i + 3u];
-    let h = array<u32, 4>(bn_u32[8u * i + 4u], bn_u32[8u * i + 5u], bn_u32[8u * i + 6u],
-        bn_u32[8u * i + 7u]);
-    let r0 = 14u * i;
-    let w = array<Real, 4>(bn_real[r0], bn_real[r0 + 1u], bn_real[r0 + 2u], bn_real[r0 + 3u]);
-    let k_axial = bn_real[r0 + 4u];
-    let k_normal = bn_real[r0 + 5u];
-    let bond_length = bn_real[r0 + 6u];
-    let plate = bn_real[r0 + 7u];
+    let node = bn_u32[6u * i];
+    let prev = bn_u32[6u * i + 1u];
+    let next = bn_u32[6u * i + 2u];
+    let c0 = bn_u32[6u * i + 3u];
+    let c1 = bn_u32[6u * i + 4u];
+    let slot = bn_u32[6u * i + 5u];
+    let r0 = 10u * i;
+    let k_axial = bn_real[r0];
+    let k_normal = bn_real[r0 + 1u];
+    let bond_length = bn_real[r0 + 2u];
+    let plate = bn_real[r0 + 3u];
     var f = array<Real, 3>(0.0, 0.0, 0.0);
     if prev != NONE {
         for (var k = 0u; k < 3u; k = k + 1u) {
@@ -205,22 +374,34 @@ fn kernel(i: u32) {
         }
     }
     let a = unit4(axis);
-    // Displacement against the host's material point (zero under rigid motion).
-    var r = displacement(node);
-    for (var q = 0u; q <= D; q = q + 1u) {
-        let u = displacement(h[q]);
-        for (var k = 0u; k < 3u; k = k + 1u) {
-            r[k] = r[k] - w[q] * u[k];
+    // Against the host's material point where the node is grouted.
+    let a0 = ALEN * i;
+    var j = c0 + u32(bolt_anchor[a0]);
+    var r = relative_disp(node, j, a0);
+    var delta = r[0] * a[0] + r[1] * a[1] + r[2] * a[2];
+    var slip = bolt_slip[i];
+    if abs(delta) > bolt_anchor[a0 + 2u * D + 2u] && c1 - c0 > 1u {
+        let moved = relocate(node, c0, c1, a0, a, r, delta);
+        if moved != NONE {
+            bolt_anchor[a0 + 2u * D + 3u] = bolt_anchor[a0 + 2u * D + 3u] + delta;
+            j = moved;
+            bolt_host[i] = Real(bp_u32[8u * j]);
+            r = relative_disp(node, j, a0);
         }
     }
-    let delta = r[0] * a[0] + r[1] * a[1] + r[2] * a[2];
+    let dl = r[0] * a[0] + r[1] * a[1] + r[2] * a[2];
+    var lateral: array<Real, 3>;
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        lateral[k] = r[k] - dl * a[k];
+    }
+    // The node's axial displacement against the rock (along the bolt's path).
+    delta = dl + bolt_anchor[a0 + 2u * D + 3u];
     var fs: Real = 0.0;
     if k_axial > 0.0 {
-        let sn = confinement(host, a, h);
-        let rock = bn_real[r0 + 8u] * (bn_real[r0 + 9u] + sn * bn_real[r0 + 10u]);
-        let bolt = bn_real[r0 + 11u] * (bn_real[r0 + 12u] + sn * bn_real[r0 + 13u]);
+        let sn = confinement(bp_u32[8u * j], a, path_nodes(j));
+        let rock = bn_real[r0 + 4u] * (bn_real[r0 + 5u] + sn * bn_real[r0 + 6u]);
+        let bolt = bn_real[r0 + 7u] * (bn_real[r0 + 8u] + sn * bn_real[r0 + 9u]);
         let cap = min(rock, bolt) * bond_length;
-        var slip = bolt_slip[i];
         let trial = k_axial * (delta - slip);
         if trial > cap {
             fs = cap;
@@ -231,25 +412,48 @@ fn kernel(i: u32) {
         } else {
             fs = trial;
         }
-        bolt_slip[i] = slip;
     }
+    bolt_slip[i] = slip;
     bolt_grout_force[i] = fs;
     var g: array<Real, 3>;
     for (var k = 0u; k < 3u; k = k + 1u) {
-        g[k] = fs * a[k] + k_normal * (r[k] - delta * a[k]);
+        g[k] = fs * a[k] + k_normal * lateral[k];
     }
     if plate > 0.0 && delta > 0.0 {
         for (var k = 0u; k < 3u; k = k + 1u) {
             g[k] = g[k] + plate * delta * a[k];
         }
     }
-    let base = (SLOT0 + i * STRIDE) * D;
+    let base = (SLOT0 + slot) * D;
     for (var k = 0u; k < D; k = k + 1u) {
         slots[base + k] = f[k] - g[k];
+        bn_grout[3u * i + k] = g[k];
     }
+}
+
+//!host_kernel
+// The grout reactions of the bolt nodes that path element j hosts, in node order (as the
+// CPU adds them), into its D + 1 slots.
+fn kernel(j: u32) {
+    let lo = bp_u32[8u * j + 5u];
+    let hi = bp_u32[8u * j + 6u];
+    let slot = bp_u32[8u * j + 7u];
+    var acc: array<Real, 12>;
+    for (var i = lo; i < hi; i = i + 1u) {
+        let a0 = ALEN * i;
+        if bn_u32[6u * i + 3u] + u32(bolt_anchor[a0]) == j {
+            for (var q = 0u; q <= D; q = q + 1u) {
+                let w = bolt_anchor[a0 + 1u + q];
+                for (var k = 0u; k < D; k = k + 1u) {
+                    acc[q * D + k] = acc[q * D + k] + w * bn_grout[3u * i + k];
+                }
+            }
+        }
+    }
+    let base = (SLOT0 + slot) * D;
     for (var q = 0u; q <= D; q = q + 1u) {
         for (var k = 0u; k < D; k = k + 1u) {
-            slots[base + (q + 1u) * D + k] = w[q] * g[k];
+            slots[base + q * D + k] = acc[q * D + k];
         }
     }
 }

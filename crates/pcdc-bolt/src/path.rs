@@ -1,0 +1,162 @@
+//! The elements along a bolt's path: the candidate hosts of its nodes.
+//!
+//! A bolt node is grouted to the element that holds it. When it leaves that element
+//! (its grout slips along the bolt, or the host breaks away and moves off), it is
+//! re-found among the elements its bolt's reference path crosses from the node two nodes
+//! before it to the node two after it ([`REACH`]; for the head and the tail, up to two
+//! end-segment lengths beyond them): the elements it can reach by sliding along the bolt
+//! by two segment lengths. Beyond that reach, or where no element holds it (an open
+//! crack, outside the rock), it stays with its last host. Each such element
+//! has force slots of its own (one per node, shared by the bolt nodes it hosts), so the
+//! engine's gather is fixed when the simulation is built and a node can change host
+//! during a run, on the GPU too.
+
+use pcdc_mesh::{Dim, Mesh};
+
+use crate::host::{Host, Locator};
+
+/// An element on a bolt's path.
+#[derive(Clone, Debug)]
+pub(crate) struct PathElement {
+    /// Element index.
+    pub element: u32,
+    /// Its `D + 1` nodes.
+    pub nodes: [u32; 4],
+    /// 2D: the adjugate of its reference edge matrix D_m (dm3, −dm1, −dm2, dm0), so that
+    /// D_x adj(D_m) = det(D_m) F gives its rotation without a division.
+    pub ref_adj: [f64; 4],
+    /// The bolt nodes (indices in the bolt-node set) whose candidates hold it:
+    /// `[first, end)`.
+    pub node_range: [u32; 2],
+}
+
+/// One bolt's path: its elements (in the order the path meets them; the path runs on
+/// [`REACH`] segment lengths beyond the head and the tail), and for each of its nodes the range of
+/// its candidates in that list and its host in the reference
+/// mesh (an index in that list, with the weights).
+pub(crate) struct BoltPath {
+    pub elements: Vec<u32>,
+    pub windows: Vec<[usize; 2]>,
+    pub hosts: Vec<(usize, Host)>,
+}
+
+/// How far a node reaches along its bolt, in segments either way (beyond the head and
+/// the tail, in lengths of the end segment).
+pub(crate) const REACH: usize = 2;
+
+/// Samples per element size along the path (an element the path only clips at a corner
+/// may be missed; a node passing through it is re-found in the next one).
+const SAMPLES_PER_CELL: f64 = 4.0;
+
+/// Finds the elements along the polyline `points` (a bolt's nodes) and each node's host.
+/// `None` with the node index when a node lies outside the mesh.
+pub(crate) fn bolt_path<D: Dim>(
+    locator: &Locator<'_, D>,
+    points: &[[f64; 3]],
+) -> Result<BoltPath, usize> {
+    let d = D::D;
+    let mut elements: Vec<u32> = Vec::new();
+    let index_of = |e: usize, elements: &mut Vec<u32>| -> usize {
+        match elements.iter().position(|&x| x as usize == e) {
+            Some(i) => i,
+            None => {
+                elements.push(e as u32);
+                elements.len() - 1
+            }
+        }
+    };
+    // The nodes' hosts first, so that each is on the path whatever the sampling finds.
+    let mut hosts = Vec::with_capacity(points.len());
+    for (k, p) in points.iter().enumerate() {
+        let host = locator.locate(&p[..d], 1e-9).ok_or(k)?;
+        hosts.push(host);
+    }
+    // The path in order: REACH end-segment lengths before the head (where the head
+    // slides to when the bolt is pulled), every segment (its samples, then its end node's
+    // host), REACH lengths beyond the tail; each stretch as the range of path indices it
+    // found, so that every node's candidates are contiguous and near each other.
+    let step = locator.cell() / SAMPLES_PER_CELL;
+    let sample = |a: [f64; 3], b: [f64; 3], elements: &mut Vec<u32>| -> [usize; 2] {
+        let len = ((0..d).map(|k| (b[k] - a[k]).powi(2)).sum::<f64>()).sqrt();
+        let n = ((len / step).ceil() as usize).clamp(1, 1 << 16);
+        let mut range = [usize::MAX, 0];
+        for i in 1..n {
+            let t = i as f64 / n as f64;
+            let p: Vec<f64> = (0..d).map(|k| a[k] + t * (b[k] - a[k])).collect();
+            if let Some(h) = locator.locate(&p, 1e-9) {
+                let j = index_of(h.element, elements);
+                range = [range[0].min(j), range[1].max(j + 1)];
+            }
+        }
+        range
+    };
+    let join = |a: [usize; 2], b: [usize; 2]| [a[0].min(b[0]), a[1].max(b[1])];
+    let last = points.len() - 1;
+    let beyond = |a: [f64; 3], b: [f64; 3]| -> [f64; 3] {
+        std::array::from_fn(|k| a[k] + REACH as f64 * (a[k] - b[k]))
+    };
+    let mut head = [usize::MAX, 0];
+    if last > 0 {
+        head = sample(beyond(points[0], points[1]), points[0], &mut elements);
+    }
+    let mut host_index = vec![0usize; points.len()];
+    host_index[0] = index_of(hosts[0].element, &mut elements);
+    head = join(head, [host_index[0], host_index[0] + 1]);
+    let mut seg_range: Vec<[usize; 2]> = Vec::with_capacity(last);
+    for s in 0..last {
+        let r = sample(points[s], points[s + 1], &mut elements);
+        let j = index_of(hosts[s + 1].element, &mut elements);
+        host_index[s + 1] = j;
+        let ends = [host_index[s].min(j), host_index[s].max(j) + 1];
+        seg_range.push(join(r, ends));
+    }
+    let mut tail = [host_index[last], host_index[last] + 1];
+    if last > 0 {
+        let far = beyond(points[last], points[last - 1]);
+        tail = join(tail, sample(points[last], far, &mut elements));
+    }
+    // Node k reaches the segments k − REACH .. k + REACH (and beyond the ends).
+    let windows = (0..points.len())
+        .map(|k| {
+            let mut w = [usize::MAX, 0];
+            for r in &seg_range[k.saturating_sub(REACH)..(k + REACH).min(last)] {
+                w = [w[0].min(r[0]), w[1].max(r[1])];
+            }
+            for r in [
+                (k < REACH).then_some(head),
+                (k + REACH > last).then_some(tail),
+            ]
+            .into_iter()
+            .flatten()
+            {
+                w = [w[0].min(r[0]), w[1].max(r[1])];
+            }
+            w
+        })
+        .collect();
+    Ok(BoltPath {
+        elements,
+        windows,
+        hosts: host_index.into_iter().zip(hosts).collect(),
+    })
+}
+
+/// The path element of `element` in `mesh`, without its node range.
+pub(crate) fn path_element<D: Dim>(mesh: &Mesh<D>, element: u32) -> PathElement {
+    let d = D::D;
+    let mut nodes = [0u32; 4];
+    nodes[..=d].copy_from_slice(mesh.element(element as usize));
+    let mut ref_adj = [0.0; 4];
+    if d == 2 {
+        let x = |q: usize| mesh.node(nodes[q] as usize);
+        let (x0, x1, x2) = (x(0), x(1), x(2));
+        let dm = [x1[0] - x0[0], x2[0] - x0[0], x1[1] - x0[1], x2[1] - x0[1]];
+        ref_adj = [dm[3], -dm[1], -dm[2], dm[0]];
+    }
+    PathElement {
+        element,
+        nodes,
+        ref_adj,
+        node_range: [u32::MAX, 0],
+    }
+}
