@@ -2,8 +2,8 @@
 //! pass (axial force, written per segment), a node pass (each bolt node gathers its two
 //! segments' forces in a fixed order, re-locates itself if it has left its host, adds
 //! the grout and plate, and writes its own slot and its grout vector) and a host pass
-//! (each element on a bolt's path sums the grout reactions of the nodes it hosts, in
-//! node order, into its slots): the CPU's arithmetic in the same order, no float
+//! (each node of the elements on a bolt's path sums the grout reactions of the bolt
+//! nodes its elements host, in bolt-node order, into its slot): the CPU's arithmetic in the same order, no float
 //! atomics. Bolt-node conditions: one kernel per item, node forces in the force phase,
 //! velocities and accelerations after the velocity update, their tables evaluated on the
 //! host per step (signals) at the times the CPU uses.
@@ -72,14 +72,14 @@ pub(crate) fn bolts<D: Dim>(b: &Bolts, setup: &mut GpuSetup<'_, D>) -> Result<()
         ]);
         seg_real.extend_from_slice(&s.dx);
     }
-    // Slots, bolt after bolt as registered: one per node, then D + 1 per path element.
-    let (mut node_slot, mut path_slot) = (Vec::new(), Vec::new());
+    // Slots, bolt after bolt as registered: one per bolt node, then one per path node.
+    let (mut node_slot, mut pn_slot) = (Vec::new(), Vec::new());
     let mut slot = 0u32;
     for span in &b.spans {
         node_slot.extend((0..span.nodes as u32).map(|i| slot + i));
         slot += span.nodes as u32;
-        path_slot.extend((0..span.path as u32).map(|j| slot + j * (d as u32 + 1)));
-        slot += (span.path * (d + 1)) as u32;
+        pn_slot.extend((0..span.path_nodes as u32).map(|m| slot + m));
+        slot += span.path_nodes as u32;
     }
     let mut node_u = Vec::with_capacity(6 * b.nodes.len());
     let mut node_r = Vec::with_capacity(10 * b.nodes.len());
@@ -88,12 +88,17 @@ pub(crate) fn bolts<D: Dim>(b: &Bolts, setup: &mut GpuSetup<'_, D>) -> Result<()
         node_r.extend_from_slice(&[n.k_axial, n.k_normal, n.bond_length, n.plate]);
         node_r.extend_from_slice(&n.bond);
     }
-    let mut path_u = Vec::with_capacity(8 * b.path.len());
-    for (pe, s) in b.path.iter().zip(&path_slot) {
+    let mut path_u = Vec::with_capacity(5 * b.path.len());
+    for pe in &b.path {
         path_u.push(pe.element);
         path_u.extend_from_slice(&pe.nodes);
-        path_u.extend_from_slice(&[pe.node_range[0], pe.node_range[1], *s]);
     }
+    let pn = &b.path_nodes;
+    let mut pn_u = Vec::with_capacity(5 * pn.nodes.len());
+    for (p, s) in pn.nodes.iter().zip(&pn_slot) {
+        pn_u.extend_from_slice(&[*s, p.node_range[0], p.node_range[1], p.refs[0], p.refs[1]]);
+    }
+    let refs: Vec<u32> = pn.refs.iter().flatten().copied().collect();
     let seg_force = vec![0.0; 3 * b.segments.len()];
     let bs_nodes = setup.upload("bolt segment nodes", GpuData::U32(nonempty(seg_nodes)));
     let bs_real = setup.upload("bolt segment laws", GpuData::Real(nonempty(seg_real)));
@@ -101,6 +106,8 @@ pub(crate) fn bolts<D: Dim>(b: &Bolts, setup: &mut GpuSetup<'_, D>) -> Result<()
     let bn_u32 = setup.upload("bolt node data", GpuData::U32(node_u));
     let bn_real = setup.upload("bolt node grout", GpuData::Real(node_r));
     let bp_u32 = setup.upload("bolt path elements", GpuData::U32(path_u));
+    let bq_u32 = setup.upload("bolt path nodes", GpuData::U32(pn_u));
+    let bq_refs = setup.upload("bolt path node corners", GpuData::U32(refs));
     let bn_grout = setup.upload(
         "bolt node grout vectors",
         GpuData::Real(vec![0.0; 3 * b.nodes.len()]),
@@ -167,11 +174,12 @@ pub(crate) fn bolts<D: Dim>(b: &Bolts, setup: &mut GpuSetup<'_, D>) -> Result<()
     let hosts = consts(Kernel::new(
         "bolt hosts",
         kernel_source("host_kernel"),
-        b.path.len(),
+        pn.nodes.len(),
     ))
     .const_u32("SLOT0", setup.slot_first())
     .bind("bn_u32", bn_u32, R)
-    .bind("bp_u32", bp_u32, R)
+    .bind("bq_u32", bq_u32, R)
+    .bind("bq_refs", bq_refs, R)
     .bind("bolt_anchor", anchor, R)
     .bind("bn_grout", bn_grout, R)
     .bind("slots", setup.slots(), W);

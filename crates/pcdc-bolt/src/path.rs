@@ -6,10 +6,10 @@
 //! before it to the node two after it ([`REACH`]; for the head and the tail, up to two
 //! end-segment lengths beyond them): the elements it can reach by sliding along the bolt
 //! by two segment lengths. Beyond that reach, or where no element holds it (an open
-//! crack, outside the rock), it stays with its last host. Each such element
-//! has force slots of its own (one per node, shared by the bolt nodes it hosts), so the
-//! engine's gather is fixed when the simulation is built and a node can change host
-//! during a run, on the GPU too.
+//! crack, outside the rock), it stays with its last host. Every node of the path's
+//! elements has a force slot of the bolt's own ([`PathNode`]), summing the reactions of
+//! the bolt nodes its elements host, so the engine's gather is fixed when the simulation
+//! is built and a node can change host during a run, on the GPU too.
 
 use pcdc_mesh::{Dim, Mesh};
 
@@ -28,6 +28,70 @@ pub(crate) struct PathElement {
     /// The bolt nodes (indices in the bolt-node set) whose candidates hold it:
     /// `[first, end)`.
     pub node_range: [u32; 2],
+    /// The index of each of its nodes among its bolt's path nodes ([`PathNode`]).
+    pub local: [u32; 4],
+}
+
+/// A mesh node of the elements on a bolt's path: one force slot, which sums the grout
+/// reactions of the bolt nodes hosted by its elements (in bolt-node order). Adjacent
+/// elements of a continuous mesh share their nodes, so there are fewer of these than
+/// element corners.
+#[derive(Clone, Debug)]
+pub(crate) struct PathNode {
+    /// Mesh node.
+    pub node: u32,
+    /// The bolt nodes that may add to it: `[first, end)`.
+    pub node_range: [u32; 2],
+    /// Its `(path element, corner)` pairs: `[first, end)` in [`PathNodes::refs`].
+    pub refs: [u32; 2],
+}
+
+/// Every bolt's path nodes (bolt after bolt) and their `(path element, corner)` pairs.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PathNodes {
+    pub nodes: Vec<PathNode>,
+    pub refs: Vec<[u32; 2]>,
+}
+
+impl PathNodes {
+    /// Adds the path nodes of one bolt's elements `path[first..]` (their node ranges
+    /// set), numbering them from 0 for that bolt in `PathElement::local`; returns how
+    /// many were added.
+    pub fn add_bolt(&mut self, d: usize, path: &mut [PathElement], first: usize) -> usize {
+        let start = self.nodes.len();
+        let mut local_of = std::collections::HashMap::new();
+        let mut lists: Vec<Vec<[u32; 2]>> = Vec::new();
+        for (j, pe) in path.iter_mut().enumerate().skip(first) {
+            for q in 0..=d {
+                let m = pe.nodes[q];
+                let local = *local_of.entry(m).or_insert_with(|| {
+                    self.nodes.push(PathNode {
+                        node: m,
+                        node_range: [u32::MAX, 0],
+                        refs: [0, 0],
+                    });
+                    lists.push(Vec::new());
+                    lists.len() - 1
+                });
+                pe.local[q] = local as u32;
+                lists[local].push([j as u32, q as u32]);
+                let pn = &mut self.nodes[start + local];
+                pn.node_range = [
+                    pn.node_range[0].min(pe.node_range[0]),
+                    pn.node_range[1].max(pe.node_range[1]),
+                ];
+            }
+        }
+        for (pn, list) in self.nodes[start..].iter_mut().zip(lists) {
+            let r0 = self.refs.len() as u32;
+            self.refs.extend(list);
+            pn.refs = [r0, self.refs.len() as u32];
+            if pn.node_range[0] > pn.node_range[1] {
+                pn.node_range = [0, 0];
+            }
+        }
+        self.nodes.len() - start
+    }
 }
 
 /// One bolt's path: its elements (in the order the path meets them; the path runs on
@@ -48,11 +112,13 @@ pub(crate) const REACH: usize = 2;
 /// may be missed; a node passing through it is re-found in the next one).
 const SAMPLES_PER_CELL: f64 = 4.0;
 
-/// Finds the elements along the polyline `points` (a bolt's nodes) and each node's host.
-/// `None` with the node index when a node lies outside the mesh.
+/// Finds the elements along the polyline `points` (a bolt's nodes) and each node's host
+/// (with `relocate` false, the hosts only). `Err` with the node index when a node lies
+/// outside the mesh.
 pub(crate) fn bolt_path<D: Dim>(
     locator: &Locator<'_, D>,
     points: &[[f64; 3]],
+    relocate: bool,
 ) -> Result<BoltPath, usize> {
     let d = D::D;
     let mut elements: Vec<u32> = Vec::new();
@@ -77,6 +143,9 @@ pub(crate) fn bolt_path<D: Dim>(
     // found, so that every node's candidates are contiguous and near each other.
     let step = locator.cell() / SAMPLES_PER_CELL;
     let sample = |a: [f64; 3], b: [f64; 3], elements: &mut Vec<u32>| -> [usize; 2] {
+        if !relocate {
+            return [usize::MAX, 0];
+        }
         let len = ((0..d).map(|k| (b[k] - a[k]).powi(2)).sum::<f64>()).sqrt();
         let n = ((len / step).ceil() as usize).clamp(1, 1 << 16);
         let mut range = [usize::MAX, 0];
@@ -115,9 +184,13 @@ pub(crate) fn bolt_path<D: Dim>(
         let far = beyond(points[last], points[last - 1]);
         tail = join(tail, sample(points[last], far, &mut elements));
     }
-    // Node k reaches the segments k − REACH .. k + REACH (and beyond the ends).
+    // Node k reaches the segments k − REACH .. k + REACH (and beyond the ends); without
+    // re-location, its host only.
     let windows = (0..points.len())
         .map(|k| {
+            if !relocate {
+                return [host_index[k], host_index[k] + 1];
+            }
             let mut w = [usize::MAX, 0];
             for r in &seg_range[k.saturating_sub(REACH)..(k + REACH).min(last)] {
                 w = [w[0].min(r[0]), w[1].max(r[1])];
@@ -158,5 +231,6 @@ pub(crate) fn path_element<D: Dim>(mesh: &Mesh<D>, element: u32) -> PathElement 
         nodes,
         ref_adj,
         node_range: [u32::MAX, 0],
+        local: [0; 4],
     }
 }

@@ -12,8 +12,8 @@ use crate::boundary::{BcKind, BoltBc, BoltNodes, ResolvedBc};
 use crate::fields::*;
 use crate::host::Locator;
 use crate::material::AxialLaw;
-use crate::path::{self, PathElement};
-use crate::walk::{self, blocks, relative_disp, BLOCK_NODES, PARALLEL_FROM};
+use crate::path::{self, PathElement, PathNodes};
+use crate::walk::{self, blocks, relative_disp, Active, BLOCK_NODES, PARALLEL_FROM};
 use crate::{Bolt, BoltError, NAME};
 
 /// A segment: its two simulation nodes, reference length and law.
@@ -78,7 +78,9 @@ pub struct Bolts {
     /// The elements along every bolt's path, bolt after bolt: the candidate hosts, each
     /// with force slots of its own.
     pub(crate) path: Vec<PathElement>,
-    /// Nodes, segments and path elements of each bolt.
+    /// The mesh nodes of the path elements, each with a force slot.
+    pub(crate) path_nodes: PathNodes,
+    /// Nodes, segments and path nodes of each bolt.
     pub(crate) spans: Vec<Span>,
     /// First bolt-node and segment index of each bolt.
     node_offset: Vec<usize>,
@@ -92,21 +94,25 @@ pub struct Bolts {
     pub(crate) blocks: Vec<usize>,
     /// [`crate::walk::PARALLEL_FROM`] and [`crate::walk::BLOCK_NODES`] (tests vary them).
     pub(crate) blocking: (usize, usize),
+    /// Whether nodes are re-found when they leave their hosts ([`Bolts::fixed_hosts`]).
+    relocate: bool,
+    /// Each bolt node's current host, cached for the walk (see [`Active`]).
+    pub(crate) active: Vec<Active>,
 }
 
-/// A bolt's share of the bolt nodes, segments and path elements. Its force slots: one per
-/// node, then `D + 1` per path element.
+/// A bolt's share of the bolt nodes, segments and path nodes. Its force
+/// slots: one per bolt node, then one per path node.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Span {
     pub nodes: usize,
     pub segments: usize,
-    pub path: usize,
+    pub path_nodes: usize,
 }
 
 impl Span {
-    /// Force slots of this bolt in `d` dimensions.
-    pub fn slots(&self, d: usize) -> usize {
-        self.nodes + self.path * (d + 1)
+    /// Force slots of this bolt.
+    pub fn slots(&self) -> usize {
+        self.nodes + self.path_nodes
     }
 }
 
@@ -137,6 +143,7 @@ impl Bolts {
             segments: Vec::new(),
             nodes: Vec::new(),
             path: Vec::new(),
+            path_nodes: PathNodes::default(),
             spans: Vec::new(),
             node_offset: Vec::new(),
             segment_offset: Vec::new(),
@@ -145,7 +152,20 @@ impl Bolts {
             ids: None,
             blocks: Vec::new(),
             blocking: (PARALLEL_FROM, BLOCK_NODES),
+            relocate: true,
+            active: Vec::new(),
         }
+    }
+
+    /// Keeps every bolt node grouted to the element found in the reference mesh for the
+    /// whole run (no re-location, see the crate docs): the grout reactions then need
+    /// force slots on the hosts' nodes only, not on every element the bolts cross. For
+    /// support that does not slip or move further than an element, where the bolts'
+    /// segments span several elements each (in the 22 600-element tunnel bench, 6.6
+    /// elements per bolt node: measured in docs/performance.md).
+    pub fn fixed_hosts(mut self) -> Self {
+        self.relocate = false;
+        self
     }
 
     /// Adds a bolt. Errors if another bolt has its name.
@@ -208,6 +228,7 @@ impl Bolts {
         self.segments.clear();
         self.nodes.clear();
         self.path.clear();
+        self.path_nodes = PathNodes::default();
         self.spans.clear();
         self.node_offset.clear();
         self.segment_offset.clear();
@@ -227,10 +248,12 @@ impl Bolts {
             let eff = bolt.material().effective(two_d);
             let pts = bolt.points();
             let n = pts.len();
-            let route = path::bolt_path(&locator, pts).map_err(|k| BoltError::OutsideMesh {
-                bolt: bolt.name().to_string(),
-                node: k,
-                position: pts[k][..d].to_vec(),
+            let route = path::bolt_path(&locator, pts, self.relocate).map_err(|k| {
+                BoltError::OutsideMesh {
+                    bolt: bolt.name().to_string(),
+                    node: k,
+                    position: pts[k][..d].to_vec(),
+                }
             })?;
             let path0 = self.path.len();
             self.path
@@ -238,7 +261,7 @@ impl Bolts {
             self.spans.push(Span {
                 nodes: n,
                 segments: n - 1,
-                path: route.elements.len(),
+                path_nodes: 0,
             });
             self.node_offset.push(self.nodes.len());
             self.segment_offset.push(self.segments.len());
@@ -305,6 +328,10 @@ impl Bolts {
                     },
                     mass: eff.mass_per_length * l,
                 });
+            }
+            let added = self.path_nodes.add_bolt(d, &mut self.path, path0);
+            if let Some(span) = self.spans.last_mut() {
+                span.path_nodes = added;
             }
             node += n as u32;
         }
@@ -380,16 +407,15 @@ impl<D: Dim> Physics<D> for Bolts {
         let mass: Vec<f64> = self.nodes.iter().map(|n| n.mass).collect();
         let block = ctx.add_nodes(&coords, &mass)?;
         debug_assert_eq!(block.first, first);
-        // Slots, bolt after bolt: one per bolt node, then the D + 1 nodes of each element
-        // on its path (the grout reactions of the nodes it hosts, summed in node order).
+        // Slots, bolt after bolt: one per bolt node, then one per node of the elements
+        // on its path (the grout reactions of the nodes they host, summed in node order).
         let mut slot_nodes = Vec::new();
         let (mut i, mut j) = (0, 0);
         for span in &self.spans {
             slot_nodes.extend(self.nodes[i..i + span.nodes].iter().map(|n| n.node));
-            for pe in &self.path[j..j + span.path] {
-                slot_nodes.extend_from_slice(&pe.nodes[..=d]);
-            }
-            (i, j) = (i + span.nodes, j + span.path);
+            let pn = &self.path_nodes.nodes[j..j + span.path_nodes];
+            slot_nodes.extend(pn.iter().map(|p| p.node));
+            (i, j) = (i + span.nodes, j + span.path_nodes);
         }
         ctx.register_slots(&slot_nodes)?;
         let ids = Ids {
@@ -423,6 +449,16 @@ impl<D: Dim> Physics<D> for Bolts {
             .get_mut(ids.anchor)
             .copy_from_slice(&self.anchor0);
         ctx.fields.get_mut(ids.host).copy_from_slice(&self.host0);
+        let alen = anchor_len(d);
+        self.active = self
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(i, n)| {
+                let j = n.cand[0] as usize + self.anchor0[i * alen] as usize;
+                Active::of(j, &self.path[j])
+            })
+            .collect();
         self.ids = Some(ids);
         self.blocks = blocks(&self.spans, self.blocking);
         Ok(())
@@ -521,7 +557,7 @@ impl<D: Dim> Physics<D> for Bolts {
             }
             let a = &anchor[i * alen..(i + 1) * alen];
             let host = &self.path[n.cand[0] as usize + a[0] as usize];
-            let r = relative_disp(n.node, host, a, kin);
+            let r = relative_disp(n.node, &host.nodes, a, kin);
             e += 0.5 * n.k_normal * (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
         }
         e
@@ -573,7 +609,7 @@ impl<D: Dim> Physics<D> for Bolts {
         for b in &self.bolts {
             f = f.debug(b);
         }
-        f.finish()
+        f.debug(&self.relocate).finish()
     }
 
     fn gpu_setup(
@@ -584,22 +620,21 @@ impl<D: Dim> Physics<D> for Bolts {
     }
 
     fn slot_entity(&self, slot: usize) -> Option<String> {
-        // Bolt after bolt: one slot per node, then D + 1 per path element.
-        let d = D::D;
-        let mut first = 0;
+        // Bolt after bolt: one slot per bolt node, then one per path node.
+        let (mut first, mut pn0) = (0, 0);
         for (b, span) in self.spans.iter().enumerate() {
             let local = slot.checked_sub(first)?;
-            if local < span.slots(d) {
+            if local < span.slots() {
                 let name = self.bolts[b].name();
                 return Some(if local < span.nodes {
                     format!("bolt '{name}' node {local}")
                 } else {
-                    let pe = &self.path[self.spans[..b].iter().map(|s| s.path).sum::<usize>()
-                        + (local - span.nodes) / (d + 1)];
-                    format!("bolt '{name}' grout on element {}", pe.element)
+                    let m = self.path_nodes.nodes[pn0 + local - span.nodes].node;
+                    format!("bolt '{name}' grout reaction on node {m}")
                 });
             }
-            first += span.slots(d);
+            first += span.slots();
+            pn0 += span.path_nodes;
         }
         None
     }
@@ -836,7 +871,7 @@ mod tests {
             .map(|&n| Span {
                 nodes: n,
                 segments: n - 1,
-                path: n,
+                path_nodes: n + 2,
             })
             .collect();
         assert_eq!(blocks(&spans, (16, 4)), vec![0]);

@@ -83,13 +83,35 @@ fn segment_state<D: Dim>(seg: &Segment, kin: &Kinematics<'_, D>) -> ([f64; 3], f
     (e, q / (l + seg.l0))
 }
 
+/// A bolt node's current host as the walk needs it, next to the node (the path element
+/// it names is far away in memory, behind the host index in [`crate::BOLT_ANCHOR`]): a
+/// cache, checked against that index before use.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Active {
+    /// Path index.
+    pub j: u32,
+    /// The host's nodes and their indices among the bolt's path nodes.
+    pub nodes: [u32; 4],
+    pub local: [u32; 4],
+}
+
+impl Active {
+    pub fn of(j: usize, pe: &PathElement) -> Self {
+        Active {
+            j: j as u32,
+            nodes: pe.nodes,
+            local: pe.local,
+        }
+    }
+}
+
 /// Displacement of bolt node `n` relative to its grout point, the material point
-/// Σ_q w_q x_q of its host `host` (weights and offset from `anchor`, see
+/// Σ_q w_q x_q of its host with nodes `host` (weights and offset from `anchor`, see
 /// [`crate::BOLT_ANCHOR`]): offset + u_n − Σ_q w_q u_q (m), which is x_n − Σ_q w_q x_q,
 /// zero under any rigid motion where the node sits at that point.
 pub(crate) fn relative_disp<D: Dim>(
     node: u32,
-    host: &PathElement,
+    host: &[u32; 4],
     anchor: &[f64],
     kin: &Kinematics<'_, D>,
 ) -> [f64; 3] {
@@ -99,7 +121,7 @@ pub(crate) fn relative_disp<D: Dim>(
         r[k] += anchor[d + 2 + k];
     }
     for q in 0..=d {
-        let u = disp(kin, host.nodes[q]);
+        let u = disp(kin, host[q]);
         (0..3).for_each(|k| r[k] -= anchor[1 + q] * u[k]);
     }
     r
@@ -253,7 +275,6 @@ struct Walk<'a> {
 struct Block<'a> {
     spans: &'a [Span],
     first_segment: usize,
-    first_path: usize,
     segments: &'a [Segment],
     nodes: &'a [BoltNode],
     axial: &'a mut [f64],
@@ -263,6 +284,7 @@ struct Block<'a> {
     slip: &'a mut [f64],
     anchor: &'a mut [f64],
     host: &'a mut [f64],
+    active: &'a mut [Active],
     slots: &'a mut [f64],
 }
 
@@ -274,6 +296,7 @@ struct NodeOut<'a> {
     slip: &'a mut f64,
     anchor: &'a mut [f64],
     host: &'a mut f64,
+    active: &'a mut Active,
 }
 
 impl Walk<'_> {
@@ -288,7 +311,6 @@ impl Walk<'_> {
         let Block {
             spans,
             first_segment,
-            mut first_path,
             segments,
             nodes,
             axial,
@@ -298,11 +320,12 @@ impl Walk<'_> {
             slip,
             anchor,
             host,
+            active,
             mut slots,
         } = b;
         let mut i0 = 0;
         for span in spans {
-            let (bolt_slots, rest) = std::mem::take(&mut slots).split_at_mut(span.slots(d) * d);
+            let (bolt_slots, rest) = std::mem::take(&mut slots).split_at_mut(span.slots() * d);
             slots = rest;
             let (own, hosts) = bolt_slots.split_at_mut(span.nodes * d);
             hosts.fill(0.0);
@@ -327,20 +350,20 @@ impl Walk<'_> {
                     slip: &mut slip[i],
                     anchor: &mut anchor[i * alen..(i + 1) * alen],
                     host: &mut host[i],
+                    active: &mut active[i],
                 };
-                self.node(n, before, next.as_ref(), kin, out, first_path, hosts);
+                self.node(n, before, next.as_ref(), kin, out, hosts);
                 prev = next;
             }
             i0 += span.nodes;
-            first_path += span.path;
         }
     }
 
     /// One bolt node: its bar forces (previous then next segment), re-location if it has
     /// left its host, the grout against the host with the host's confinement, the
     /// lateral grout and the face plate; writes its slot, its grout force, slip, grout
-    /// point and host, and adds the reaction to its host's slots among `hosts` (the
-    /// slots of its bolt's path elements, the first of which is `first_path`).
+    /// point and host, and adds the reaction to its host's nodes' slots among `hosts`
+    /// (the slots of its bolt's path nodes).
     #[allow(clippy::too_many_arguments)]
     fn node<D: Dim>(
         &self,
@@ -349,7 +372,6 @@ impl Walk<'_> {
         next: Option<&SegmentOut>,
         kin: &Kinematics<'_, D>,
         out: NodeOut<'_>,
-        first_path: usize,
         hosts: &mut [f64],
     ) {
         let d = D::D;
@@ -370,17 +392,21 @@ impl Walk<'_> {
         let (a, _) = unit(axis);
         // Against the host's material point where the node is grouted.
         let anchor = out.anchor;
-        let mut j = n.cand[0] as usize + anchor[0] as usize;
-        let mut r = relative_disp(n.node, &self.path[j], anchor, kin);
+        let active = out.active;
+        let j = n.cand[0] as usize + anchor[0] as usize;
+        if active.j as usize != j {
+            *active = Active::of(j, &self.path[j]);
+        }
+        let mut r = relative_disp(n.node, &active.nodes, anchor, kin);
         let mut delta = r[0] * a[0] + r[1] * a[1] + r[2] * a[2];
         if delta.abs() > anchor[2 * d + 2] && n.cand[1] - n.cand[0] > 1 {
             if let Some(k) = relocate(n, self.path, anchor, &a, &r, delta, kin) {
                 // The axial part of the relative displacement is carried over: the
                 // grout's δ, force and slip go on unchanged.
                 anchor[2 * d + 3] += delta;
-                j = k;
-                *out.host = self.path[j].element as f64;
-                r = relative_disp(n.node, &self.path[j], anchor, kin);
+                *active = Active::of(k, &self.path[k]);
+                *out.host = self.path[k].element as f64;
+                r = relative_disp(n.node, &active.nodes, anchor, kin);
             }
         }
         let lateral: [f64; 3] = {
@@ -389,7 +415,6 @@ impl Walk<'_> {
         };
         // The node's axial displacement against the rock (along the bolt's path).
         delta = r[0] * a[0] + r[1] * a[1] + r[2] * a[2] + anchor[2 * d + 3];
-        let pe = &self.path[j];
         // Grout along the axis: bond-slip with the host's confinement.
         let slip = out.slip;
         let mut fs = 0.0;
@@ -398,6 +423,7 @@ impl Walk<'_> {
             // Elastic under any confinement: the same force and slip as below, exactly.
             fs = trial;
         } else if n.k_axial > 0.0 {
+            let pe = &self.path[active.j as usize];
             let e = pe.element as usize;
             let mut rot = [0.0; 9];
             if d == 2 {
@@ -422,11 +448,10 @@ impl Walk<'_> {
         for k in 0..d {
             out.slot[k] = f[k] - g[k];
         }
-        let base = (j - first_path) * (d + 1) * d;
         for q in 0..=d {
-            let w = anchor[1 + q];
+            let (w, base) = (anchor[1 + q], active.local[q] as usize * d);
             for (k, gk) in g.iter().enumerate().take(d) {
-                hosts[base + q * d + k] += w * gk;
+                hosts[base + k] += w * gk;
             }
         }
     }
@@ -497,7 +522,6 @@ impl Bolts {
         let whole = Block {
             spans: &self.spans,
             first_segment: 0,
-            first_path: 0,
             segments: &self.segments,
             nodes: &self.nodes,
             axial,
@@ -507,6 +531,7 @@ impl Bolts {
             slip,
             anchor,
             host,
+            active: &mut self.active,
             slots: ctx.slots,
         };
         if self.blocks.len() <= 1 {
@@ -527,8 +552,8 @@ fn split_blocks<'a>(mut rest: Block<'a>, blocks: &[usize], d: usize) -> Vec<Bloc
     for w in blocks.windows(2) {
         let (spans, spans_r) = rest.spans.split_at(w[1] - w[0]);
         let sum = |f: fn(&Span) -> usize| spans.iter().map(f).sum::<usize>();
-        let (n, s, p) = (sum(|x| x.nodes), sum(|x| x.segments), sum(|x| x.path));
-        let slots_n = n + p * (d + 1);
+        let (n, s) = (sum(|x| x.nodes), sum(|x| x.segments));
+        let slots_n = n + sum(|x| x.path_nodes);
         let (axial, axial_r) = std::mem::take(&mut rest.axial).split_at_mut(s);
         let (plastic, plastic_r) = std::mem::take(&mut rest.plastic).split_at_mut(s);
         let (state, state_r) = std::mem::take(&mut rest.state).split_at_mut(s);
@@ -536,13 +561,13 @@ fn split_blocks<'a>(mut rest: Block<'a>, blocks: &[usize], d: usize) -> Vec<Bloc
         let (slip, slip_r) = std::mem::take(&mut rest.slip).split_at_mut(n);
         let (anchor, anchor_r) = std::mem::take(&mut rest.anchor).split_at_mut(n * alen);
         let (host, host_r) = std::mem::take(&mut rest.host).split_at_mut(n);
+        let (active, active_r) = std::mem::take(&mut rest.active).split_at_mut(n);
         let (slots, slots_r) = std::mem::take(&mut rest.slots).split_at_mut(slots_n * d);
         let (segments, segments_r) = rest.segments.split_at(s);
         let (nodes, nodes_r) = rest.nodes.split_at(n);
         out.push(Block {
             spans,
             first_segment: rest.first_segment,
-            first_path: rest.first_path,
             segments,
             nodes,
             axial,
@@ -552,12 +577,12 @@ fn split_blocks<'a>(mut rest: Block<'a>, blocks: &[usize], d: usize) -> Vec<Bloc
             slip,
             anchor,
             host,
+            active,
             slots,
         });
         rest = Block {
             spans: spans_r,
             first_segment: rest.first_segment + s,
-            first_path: rest.first_path + p,
             segments: segments_r,
             nodes: nodes_r,
             axial: axial_r,
@@ -567,6 +592,7 @@ fn split_blocks<'a>(mut rest: Block<'a>, blocks: &[usize], d: usize) -> Vec<Bloc
             slip: slip_r,
             anchor: anchor_r,
             host: host_r,
+            active: active_r,
             slots: slots_r,
         };
     }

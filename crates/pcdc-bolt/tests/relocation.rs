@@ -26,7 +26,7 @@ fn material() -> BoltMaterial {
 
 /// A block held fixed with a bolt from `head` to `tail` in `segments`, its head pulled
 /// out along the bolt at `speed` (m/s, reached after 1 ms); with `hold_y` every bolt
-/// node is held at y velocity 0.
+/// node is held at y velocity 0; with `fixed` the hosts are kept.
 fn scene<D: Dim>(
     mesh: Mesh<D>,
     backend: Backend,
@@ -34,9 +34,13 @@ fn scene<D: Dim>(
     segments: usize,
     speed: f64,
     hold_y: bool,
+    fixed: bool,
 ) -> Simulation<D> {
     let bolt = Bolt::straight("B", head, tail, segments, material()).unwrap();
-    let bolts = Bolts::new().bolt(bolt).unwrap();
+    let mut bolts = Bolts::new().bolt(bolt).unwrap();
+    if fixed {
+        bolts = bolts.fixed_hosts();
+    }
     let len: f64 = (0..3)
         .map(|k| (tail[k] - head[k]).powi(2))
         .sum::<f64>()
@@ -90,7 +94,7 @@ fn a_bolt_pulled_through_the_rock_is_re_found_where_it_is() {
     // seen with and without re-location), which this test is not about.
     let mesh = builders::rectangle(0.0, 0.0, 1.3, 0.4, 0.05).unwrap();
     let ends = ([0.3, 0.2137, 0.0], [1.2, 0.2137, 0.0]);
-    let mut sim = scene(mesh, Backend::cpu(1).unwrap(), ends, 9, 2.0, true);
+    let mut sim = scene(mesh, Backend::cpu(1).unwrap(), ends, 9, 2.0, true, false);
     let hosts0 = sim.field(BOLT_HOST).unwrap().to_vec();
     let first = sim.mesh().n_nodes();
     let n = hosts0.len();
@@ -148,10 +152,27 @@ fn a_bolt_pulled_through_the_rock_is_re_found_where_it_is() {
 }
 
 #[test]
+fn fixed_hosts_stay_where_they_were_found() {
+    // The same pull with re-location off: every node keeps its reference host (and
+    // lies far outside it at the end), the grout still carries the bond strength.
+    let mesh = builders::rectangle(0.0, 0.0, 1.3, 0.4, 0.05).unwrap();
+    let ends = ([0.3, 0.2137, 0.0], [1.2, 0.2137, 0.0]);
+    let mut sim = scene(mesh, Backend::cpu(1).unwrap(), ends, 9, 2.0, true, true);
+    let hosts0 = sim.field(BOLT_HOST).unwrap().to_vec();
+    sim.run_until(0.076).unwrap();
+    assert_eq!(sim.field(BOLT_HOST).unwrap(), &hosts0[..]);
+    let first = sim.mesh().n_nodes();
+    assert!(weight_in_host(&sim, 5, first + 5) < -1.0);
+    let total: f64 = sim.field(BOLT_GROUT_FORCE).unwrap().iter().sum();
+    let capacity = material().bond_strength(0.0) * 0.9;
+    assert!(((-total - capacity) / capacity).abs() < 1e-9, "{total}");
+}
+
+#[test]
 fn forged_grout_points_are_refused_on_restore() {
     let mesh = builders::rectangle(0.0, 0.0, 1.3, 0.4, 0.05).unwrap();
     let ends = ([0.3, 0.213, 0.0], [1.2, 0.171, 0.0]);
-    let mut sim = scene(mesh, Backend::cpu(1).unwrap(), ends, 9, 5.0, false);
+    let mut sim = scene(mesh, Backend::cpu(1).unwrap(), ends, 9, 5.0, false, false);
     sim.run(10).unwrap();
     let good = sim.snapshot_bytes().unwrap();
     // Forged with a valid checksum: written from a simulation whose field was edited.
@@ -162,6 +183,7 @@ fn forged_grout_points_are_refused_on_restore() {
             ends,
             9,
             5.0,
+            false,
             false,
         );
         other.restore_bytes(&good).unwrap();
@@ -200,29 +222,45 @@ fn the_gpu_re_locates_as_the_cpu_2d_and_3d() {
     let m2: Mesh<Dim2> = builders::rectangle(0.0, 0.0, 1.0, 0.3, 0.1).unwrap();
     let e2 = ([0.3, 0.163, 0.0], [0.9, 0.121, 0.0]);
     let run = |backend: Backend| {
-        let mut s = scene(m2.clone(), backend, e2, 6, 20.0, false);
+        let mut s = scene(m2.clone(), backend, e2, 6, 20.0, false, false);
         s.run(1500).unwrap();
         s
     };
     let (c, g) = (run(Backend::cpu(1).unwrap()), run(gpu.clone()));
-    let hosts0 = scene(m2.clone(), Backend::cpu(1).unwrap(), e2, 6, 20.0, false)
-        .field(BOLT_HOST)
-        .unwrap()
-        .to_vec();
+    let hosts0 = scene(
+        m2.clone(),
+        Backend::cpu(1).unwrap(),
+        e2,
+        6,
+        20.0,
+        false,
+        false,
+    )
+    .field(BOLT_HOST)
+    .unwrap()
+    .to_vec();
     assert_ne!(c.field(BOLT_HOST).unwrap(), &hosts0[..], "nodes re-located");
     compare(&c, &g, "2D");
     let m3: Mesh<Dim3> = builders::cuboid([0.0; 3], [0.6, 0.6, 1.0], 0.2).unwrap();
     let e3 = ([0.27, 0.33, 0.9], [0.35, 0.21, 0.15]);
     let run = |backend: Backend| {
-        let mut s = scene(m3.clone(), backend, e3, 5, 40.0, false);
+        let mut s = scene(m3.clone(), backend, e3, 5, 40.0, false, false);
         s.run(1500).unwrap();
         s
     };
     let (c, g) = (run(Backend::cpu(1).unwrap()), run(gpu));
-    let hosts0 = scene(m3.clone(), Backend::cpu(1).unwrap(), e3, 5, 40.0, false)
-        .field(BOLT_HOST)
-        .unwrap()
-        .to_vec();
+    let hosts0 = scene(
+        m3.clone(),
+        Backend::cpu(1).unwrap(),
+        e3,
+        5,
+        40.0,
+        false,
+        false,
+    )
+    .field(BOLT_HOST)
+    .unwrap()
+    .to_vec();
     assert_ne!(c.field(BOLT_HOST).unwrap(), &hosts0[..], "nodes re-located");
     compare(&c, &g, "3D");
 }

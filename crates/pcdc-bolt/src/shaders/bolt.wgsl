@@ -3,15 +3,17 @@
 // kernel after a marker line (two slashes, a bang and its name): `segment_kernel` (axial
 // force per segment), `node_kernel` (bar forces gathered from the node's two segments in
 // a fixed order, re-location, grout against the host, face plate; writes the node's slot
-// and its grout vector), then `host_kernel` (per element on a bolt's path: the grout
-// reactions of the bolt nodes it hosts, in node order, into its slots).
+// and its grout vector), then `host_kernel` (per node of the elements on a bolt's path:
+// the grout reactions of the bolt nodes its elements host, in node order, into its slot).
 //
 // Consts: D, NSYM, SLOT0 (first slot), NONE, ALEN (2D + 3 values of bolt_anchor per node).
 // bs_nodes: 2 nodes per segment; bs_real (BS_STRIDE = 9 per segment): l0, EA, f_t, f_c,
 // ε_f, damping, reference vector ΔX;
 // bn_u32 (6 per bolt node): node, prev, next, first and end candidate (path index), slot;
 // bn_real (10 per node): k_axial, k_normal, bond length, plate, 6 bond constants;
-// bp_u32 (8 per path element): element, 4 nodes, first and end bolt node hosted, slot;
+// bp_u32 (5 per path element): element, 4 nodes;
+// bq_u32 (5 per path node): slot, first and end bolt node that may add to it, first and
+// end of its (path element, corner) pairs in bq_refs;
 // bolt_anchor (ALEN per node): candidate index, D + 1 weights, D offsets, margin, axial
 // displacement carried over.
 
@@ -105,8 +107,8 @@ fn position(n: u32) -> array<Real, 3> {
 }
 
 fn path_nodes(j: u32) -> array<u32, 4> {
-    return array<u32, 4>(bp_u32[8u * j + 1u], bp_u32[8u * j + 2u], bp_u32[8u * j + 3u],
-        bp_u32[8u * j + 4u]);
+    return array<u32, 4>(bp_u32[5u * j + 1u], bp_u32[5u * j + 2u], bp_u32[5u * j + 3u],
+        bp_u32[5u * j + 4u]);
 }
 
 // Current positions of a path element's D + 1 nodes (stride D).
@@ -385,7 +387,7 @@ fn kernel(i: u32) {
         if moved != NONE {
             bolt_anchor[a0 + 2u * D + 3u] = bolt_anchor[a0 + 2u * D + 3u] + delta;
             j = moved;
-            bolt_host[i] = Real(bp_u32[8u * j]);
+            bolt_host[i] = Real(bp_u32[5u * j]);
             r = relative_disp(node, j, a0);
         }
     }
@@ -398,7 +400,7 @@ fn kernel(i: u32) {
     delta = dl + bolt_anchor[a0 + 2u * D + 3u];
     var fs: Real = 0.0;
     if k_axial > 0.0 {
-        let sn = confinement(bp_u32[8u * j], a, path_nodes(j));
+        let sn = confinement(bp_u32[5u * j], a, path_nodes(j));
         let rock = bn_real[r0 + 4u] * (bn_real[r0 + 5u] + sn * bn_real[r0 + 6u]);
         let bolt = bn_real[r0 + 7u] * (bn_real[r0 + 8u] + sn * bn_real[r0 + 9u]);
         let cap = min(rock, bolt) * bond_length;
@@ -432,28 +434,30 @@ fn kernel(i: u32) {
 }
 
 //!host_kernel
-// The grout reactions of the bolt nodes that path element j hosts, in node order (as the
-// CPU adds them), into its D + 1 slots.
-fn kernel(j: u32) {
-    let lo = bp_u32[8u * j + 5u];
-    let hi = bp_u32[8u * j + 6u];
-    let slot = bp_u32[8u * j + 7u];
-    var acc: array<Real, 12>;
+// Path node m: the grout reactions of the bolt nodes hosted by its elements, in bolt-node
+// order (as the CPU adds them), into its slot.
+fn kernel(m: u32) {
+    let slot = bq_u32[5u * m];
+    let lo = bq_u32[5u * m + 1u];
+    let hi = bq_u32[5u * m + 2u];
+    let r0 = bq_u32[5u * m + 3u];
+    let r1 = bq_u32[5u * m + 4u];
+    var acc = array<Real, 3>(0.0, 0.0, 0.0);
     for (var i = lo; i < hi; i = i + 1u) {
         let a0 = ALEN * i;
-        if bn_u32[6u * i + 3u] + u32(bolt_anchor[a0]) == j {
-            for (var q = 0u; q <= D; q = q + 1u) {
-                let w = bolt_anchor[a0 + 1u + q];
+        let host = bn_u32[6u * i + 3u] + u32(bolt_anchor[a0]);
+        for (var r = r0; r < r1; r = r + 1u) {
+            if bq_refs[2u * r] == host {
+                let w = bolt_anchor[a0 + 1u + bq_refs[2u * r + 1u]];
                 for (var k = 0u; k < D; k = k + 1u) {
-                    acc[q * D + k] = acc[q * D + k] + w * bn_grout[3u * i + k];
+                    acc[k] = acc[k] + w * bn_grout[3u * i + k];
                 }
+                break;
             }
         }
     }
     let base = (SLOT0 + slot) * D;
-    for (var q = 0u; q <= D; q = q + 1u) {
-        for (var k = 0u; k < D; k = k + 1u) {
-            slots[base + q * D + k] = acc[q * D + k];
-        }
+    for (var k = 0u; k < D; k = k + 1u) {
+        slots[base + k] = acc[k];
     }
 }
