@@ -85,7 +85,7 @@
 //!
 //! On the GPU the bolts run as three force-phase kernels (segments; nodes: each node
 //! gathers its two segments in a fixed order, re-locates if it must, and writes its own
-//! slot; hosts: each element on a path sums the reactions of the nodes it hosts), with
+//! slot; hosts: each node of a path's elements sums the reactions it receives), with
 //! the CPU's arithmetic in the same order and no float atomics.
 //!
 //! # Re-locating
@@ -102,10 +102,12 @@
 //! kept and the axial part is carried over ([`BOLT_ANCHOR`]), so the grout's δ, force
 //! and slip go on unchanged; [`BOLT_HOST`] names the host. Beyond that reach, or where
 //! no element holds the point (an open crack, the air outside a spalled face), the node
-//! stays with its last host. Each element on a bolt's path has force slots of its own,
-//! summing the reactions of the nodes it hosts in node order, so the engine's gather is
-//! fixed when the simulation is built and re-location needs no host round trip on the
-//! GPU. A node is checked only once its axial relative displacement exceeds the
+//! stays with its last host. Each node of the elements on a bolt's path has a force slot
+//! of the bolt's own, summing the reactions of the bolt nodes its elements host in node
+//! order, so the engine's gather is fixed when the simulation is built and re-location
+//! needs no host round trip on the GPU. [`Bolts::fixed_hosts`] turns re-location off
+//! (the slots are then on the hosts' nodes only: cheaper where segments span several
+//! elements). A node is checked only once its axial relative displacement exceeds the
 //! distance its weights allow (less than the smallest height, halved for the host's
 //! deformation), so nodes that stay put cost nothing.
 
