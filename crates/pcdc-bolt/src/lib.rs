@@ -60,6 +60,21 @@
 //! by √(1 + ζ²) − ζ for the axial damping; it enters the simulation's step like every
 //! other physics' limit and names the limiting bolt node.
 //!
+//! # Known limit: sideways flutter of a bolt sliding at its bond strength
+//!
+//! The grout force acts along the bolt's current axis at the node, the mean direction of
+//! its two segments. While a node slides at the bond strength that force has a fixed
+//! size and turns with the neighbouring nodes' sideways displacements: a follower force,
+//! which couples the bolt's lateral modes antisymmetrically and makes them grow slowly
+//! when nothing damps them. Seen (2026-12-07) in a 0.9 m rebar dragged 15 cm through a
+//! fixed block at 2 m/s with local damping 0.3 and the axial damping of eq. 148
+//! (D_b,f = 0.5): the nodes began to swing ±1 cm sideways after 6 000 to 12 000 steps
+//! (without re-location and with it), and the grout forces then changed sign. A pull-out of a few centimetres (the validation
+//! scenes) does not reach it. The growth rate is small (about the bond force over the
+//! segment length against the lateral grout stiffness), so any damping of the lateral
+//! grout motion would stop it; the model has none yet (the damping of eq. 148 acts on
+//! the segments' axial stretching rate only).
+//!
 //! # Composing
 //!
 //! ```rust,ignore
