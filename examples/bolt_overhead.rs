@@ -64,6 +64,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let ne = simulation(&backend, size, None)?.mesh().n_elements();
         let n_bolts = (ne / per).max(1);
         let mut best = [f64::INFINITY; 2];
+        let probe = simulation(&backend, size, Some(bolt_pattern(n_bolts)?))?;
+        for (a, b) in probe.physics_beside() {
+            println!("threads {t}: '{b}' runs beside '{a}'");
+        }
         for _ in 0..rounds {
             for (i, bolts) in [None, Some(n_bolts)].into_iter().enumerate() {
                 let pattern = bolts.map(bolt_pattern).transpose()?;

@@ -527,6 +527,13 @@ impl<D: Dim> Physics<D> for Bolts {
         true
     }
 
+    fn runs_beside(&self) -> bool {
+        // The walk is short and serial below 2 048 bolt nodes: beside a heavy physics it
+        // keeps the pool's other threads busy (docs/performance.md); it reads only the
+        // fields it declares.
+        true
+    }
+
     fn kinematic_nodes(&self) -> KinematicNodes {
         // No kinematic conditions here (they are `BoltBoundary`'s): the engine keeps its
         // fused node pass.
@@ -860,7 +867,7 @@ mod tests {
     use super::*;
     use crate::{Bolt, BoltMaterial, BoltProperties};
     use pcdc_compute::{Backend, Simulation};
-    use pcdc_mech::{LinearElastic, Mechanics};
+    use pcdc_mech::{Boundary, LinearElastic, Mechanics};
     use pcdc_mesh::{builders, Dim2, Range};
 
     #[test]
@@ -883,8 +890,10 @@ mod tests {
         assert_eq!(blocks(&spans, (1, 1)).len(), 4);
     }
 
-    /// A plate under gravity with 60 pretensioned, plated bolts, run with `blocking`.
-    fn bolted_plate(blocking: (usize, usize)) -> Simulation<Dim2> {
+    /// A plate under gravity with 60 pretensioned, plated bolts, run with `blocking` on
+    /// `threads` threads (its base held by a boundary physics, which the bolts may run
+    /// beside).
+    fn bolted_plate(blocking: (usize, usize), threads: usize) -> Simulation<Dim2> {
         let mesh = builders::rectangle(0.0, 0.0, 4.0, 1.0, 0.1).unwrap();
         let props = BoltProperties {
             cohesion_rock_grout: 2e3,
@@ -906,8 +915,9 @@ mod tests {
         }
         bolts.blocking = blocking;
         let rock = LinearElastic::new(2e8, 0.25, 2000.0).unwrap();
-        Simulation::builder(mesh, Backend::cpu(2).unwrap())
+        Simulation::builder(mesh, Backend::cpu(threads).unwrap())
             .physics(Mechanics::new().material(Range::All, rock))
+            .physics(Boundary::new().fix(Range::group("bottom")))
             .physics(bolts)
             .gravity([0.0, -9.81, 0.0])
             .build()
@@ -916,7 +926,7 @@ mod tests {
 
     #[test]
     fn bolts_split_in_blocks_give_the_single_block_result_bit_for_bit() {
-        let (mut one, mut split) = (bolted_plate((usize::MAX, 1)), bolted_plate((1, 50)));
+        let (mut one, mut split) = (bolted_plate((usize::MAX, 1), 2), bolted_plate((1, 50), 2));
         one.run(300).unwrap();
         split.run(300).unwrap();
         assert_eq!(one.state.u, split.state.u);
@@ -932,4 +942,23 @@ mod tests {
         assert!(axial.iter().any(|f| f.abs() > 1e3), "{axial:?}");
         assert!(one.field(BOLT_SLIP).unwrap().iter().any(|s| *s != 0.0));
     }
+
+    #[test]
+    fn bolts_beside_another_physics_give_the_one_thread_result_bit_for_bit() {
+        let (mut one, mut two) = (bolted_plate(BLOCKING, 1), bolted_plate(BLOCKING, 2));
+        // The bolts read the mechanics' stress, so they pair with the boundary after it.
+        assert_eq!(two.physics_beside(), vec![("mechanical boundary", NAME)]);
+        one.run(300).unwrap();
+        two.run(300).unwrap();
+        assert_eq!(one.state.u, two.state.u);
+        for name in [BOLT_AXIAL_FORCE, BOLT_GROUT_FORCE, BOLT_SLIP, BOLT_ANCHOR] {
+            assert_eq!(
+                one.field(name).unwrap(),
+                two.field(name).unwrap(),
+                "{name:?}"
+            );
+        }
+    }
+
+    const BLOCKING: (usize, usize) = (PARALLEL_FROM, BLOCK_NODES);
 }

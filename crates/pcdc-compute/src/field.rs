@@ -486,6 +486,21 @@ impl FieldStore {
                 .all(|(a, b)| a.len() == b.len())
     }
 
+    /// A store with the same declarations and no values (every field empty): the other
+    /// half of [`FieldStore::swap_field`].
+    pub(crate) fn empty_like(&self) -> FieldStore {
+        FieldStore {
+            specs: self.specs.clone(),
+            data: vec![Vec::new(); self.data.len()],
+        }
+    }
+
+    /// Exchanges the values of field `id` with those in `other` (same declarations): a
+    /// move of the array, not a copy.
+    pub(crate) fn swap_field(&mut self, other: &mut FieldStore, id: FieldId) {
+        std::mem::swap(&mut self.data[id.0], &mut other.data[id.0]);
+    }
+
     /// Total bytes held by all fields.
     pub fn bytes(&self) -> usize {
         self.data.iter().map(|d| d.len() * 8).sum()

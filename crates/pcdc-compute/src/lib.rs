@@ -23,6 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod backend;
+mod beside;
 pub mod coupling;
 mod energy;
 mod entity_set;

@@ -548,6 +548,18 @@ pub trait Physics<D: Dim>: Send + Sync {
         false
     }
 
+    /// Whether this physics' forces stage is short and serial (e.g. a few hundred rock
+    /// bolts walked on one thread) and uses only the fields it declares in
+    /// [`Physics::fields`]: the CPU step may then run it beside an earlier physics with
+    /// which, and with every physics between them, it shares no field (`rayon::join`;
+    /// its fields are moved to a store of its own for the time), so that the pool's
+    /// other threads work on that physics instead of idling through this one. The result
+    /// is the same: the two write disjoint slots and fields and read the same kinematics.
+    /// Default: no.
+    fn runs_beside(&self) -> bool {
+        false
+    }
+
     /// Whether [`Physics::compute_forces`] writes every value of its slot block every
     /// step (zeros included), so the engine need not clear the block before it; the
     /// default `false` has the block cleared, and a physics may then add into it.

@@ -252,7 +252,14 @@ impl<D: Dim> SimulationBuilder<D> {
             energy: None,
             field_stages: Vec::new(),
             kinematic_nodes: None,
+            beside: None,
         };
+        sim.beside = Some(Box::new(crate::beside::Beside::plan(
+            &sim.mesh,
+            &sim.physics,
+            &sim.state.fields,
+            sim.backend.threads(),
+        )?));
         sim.kinematic_nodes = crate::node_pass::kinematic_nodes(&sim.physics, n_nodes)?;
         if let Some(tol) = energy {
             let loads: Vec<bool> = sim.physics.iter().map(|p| p.applies_loads()).collect();
@@ -540,6 +547,8 @@ pub struct Simulation<D: Dim> {
     /// The nodes whose velocity a kinematic condition writes (sorted, unique) when every
     /// physics names them: then the CPU step fuses the node passes (`node_pass.rs`).
     pub(crate) kinematic_nodes: Option<Vec<u32>>,
+    /// Which physics run beside which in the CPU forces stage (`beside.rs`).
+    pub(crate) beside: Option<Box<crate::beside::Beside>>,
 }
 
 impl<D: Dim> Simulation<D> {
@@ -623,6 +632,19 @@ impl<D: Dim> Simulation<D> {
         self.gpu.as_ref().map(|g| g.bytes_per_step())
     }
 
+    /// The pairs of physics whose forces the CPU step computes side by side (the second
+    /// [`Physics::runs_beside`] the first), by name; empty on one thread.
+    pub fn physics_beside(&self) -> Vec<(&str, &str)> {
+        let Some(b) = self.beside.as_deref() else {
+            return Vec::new();
+        };
+        b.partner
+            .iter()
+            .enumerate()
+            .filter_map(|(h, l)| l.map(|l| (self.physics[h].name(), self.physics[l].name())))
+            .collect()
+    }
+
     /// Whether the CPU step runs its node work in one fused pass: every composed physics
     /// names the nodes its kinematic conditions write ([`Physics::kinematic_nodes`]).
     pub fn fuses_node_passes(&self) -> bool {
@@ -673,34 +695,92 @@ impl<D: Dim> Simulation<D> {
     }
 
     /// Lets every physics write its forces, clearing its slots first unless it writes
-    /// every one of them ([`Physics::writes_all_slots`]).
+    /// every one of them ([`Physics::writes_all_slots`]); a physics that runs beside an
+    /// earlier one ([`Physics::runs_beside`]) runs with it in a `rayon::join`.
     fn physics_forces(&mut self) -> Result<(), ComputeError> {
         let d = D::D;
-        let kin_u = &self.state.u;
-        let kin_v = &self.state.v;
+        let (u, v) = (&self.state.u, &self.state.v);
+        let (time, step) = (self.state.time, self.state.step);
+        let kin = || Kinematics {
+            mesh: &self.mesh,
+            coords: &self.coords,
+            mass: &self.mass_phys,
+            u,
+            v,
+            time,
+            dt: self.dt,
+            step,
+            damping: self.damping,
+        };
         let fields = &mut self.state.fields;
-        for (p, r) in self.physics.iter_mut().zip(&self.slot_ranges) {
-            let slots = &mut self.slot_forces[r.start * d..r.end * d];
+        let backend = &self.backend;
+        let mut beside = self.beside.as_deref_mut();
+        let mut slots_rest: &mut [f64] = &mut self.slot_forces;
+        let mut taken = 0;
+        // Each physics' slot block, in order (the ranges are consecutive).
+        let mut blocks: Vec<Option<&mut [f64]>> = Vec::with_capacity(self.slot_ranges.len());
+        for r in &self.slot_ranges {
+            let (block, rest) = std::mem::take(&mut slots_rest).split_at_mut((r.end - taken) * d);
+            let (_, block) = block.split_at_mut((r.start - taken) * d);
+            slots_rest = rest;
+            taken = r.end;
+            blocks.push(Some(block));
+        }
+        let mut physics: Vec<Option<&mut Box<dyn Physics<D>>>> =
+            self.physics.iter_mut().map(Some).collect();
+        for i in 0..physics.len() {
+            if beside.as_ref().is_some_and(|b| b.skip[i]) {
+                continue;
+            }
+            let partner = beside.as_ref().and_then(|b| b.partner[i]);
+            let (Some(p), Some(slots)) = (physics[i].take(), blocks[i].take()) else {
+                continue;
+            };
             if !p.writes_all_slots() {
                 slots.fill(0.0);
             }
-            let mut ctx = ForceContext {
-                kin: Kinematics {
-                    mesh: &self.mesh,
-                    coords: &self.coords,
-                    mass: &self.mass_phys,
-                    u: kin_u,
-                    v: kin_v,
-                    time: self.state.time,
-                    dt: self.dt,
-                    step: self.state.step,
-                    damping: self.damping,
-                },
-                fields,
-                slots,
-                backend: &self.backend,
+            let Some(l) = partner else {
+                let mut ctx = ForceContext {
+                    kin: kin(),
+                    fields,
+                    slots,
+                    backend,
+                };
+                p.compute_forces(&mut ctx)?;
+                continue;
             };
-            p.compute_forces(&mut ctx)?;
+            let (Some(q), Some(q_slots)) = (physics[l].take(), blocks[l].take()) else {
+                continue;
+            };
+            if !q.writes_all_slots() {
+                q_slots.fill(0.0);
+            }
+            let side = beside.as_deref_mut().expect("a partner comes from a plan");
+            side.swap(fields, l);
+            let side_fields = &mut side.side;
+            let (a, b) = backend.install(|| {
+                rayon::join(
+                    || {
+                        p.compute_forces(&mut ForceContext {
+                            kin: kin(),
+                            fields,
+                            slots,
+                            backend,
+                        })
+                    },
+                    || {
+                        q.compute_forces(&mut ForceContext {
+                            kin: kin(),
+                            fields: side_fields,
+                            slots: q_slots,
+                            backend,
+                        })
+                    },
+                )
+            });
+            side.swap(fields, l);
+            a?;
+            b?;
         }
         Ok(())
     }
