@@ -149,7 +149,7 @@ pub(crate) fn bolt_path<D: Dim>(
         let len = ((0..d).map(|k| (b[k] - a[k]).powi(2)).sum::<f64>()).sqrt();
         let n = ((len / step).ceil() as usize).clamp(1, 1 << 16);
         let mut range = [usize::MAX, 0];
-        for i in 1..n {
+        for i in 1..=n {
             let t = i as f64 / n as f64;
             let p: Vec<f64> = (0..d).map(|k| a[k] + t * (b[k] - a[k])).collect();
             if let Some(h) = locator.locate(&p, 1e-9) {
@@ -232,5 +232,92 @@ pub(crate) fn path_element<D: Dim>(mesh: &Mesh<D>, element: u32) -> PathElement 
         ref_adj,
         node_range: [u32::MAX, 0],
         local: [0; 4],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pcdc_mesh::{builders, Dim2};
+
+    #[test]
+    fn windows_hold_the_own_host_and_reach_two_segments_and_beyond_the_ends() {
+        // Elements 0.1 m across, a bolt of five 0.2 m segments off the mesh lines.
+        let mesh = builders::rectangle(0.0, 0.0, 2.0, 1.0, 0.1).unwrap();
+        let locator = Locator::new(&mesh);
+        let pts: Vec<[f64; 3]> = (0..6)
+            .map(|k| [0.55 + 0.2 * k as f64, 0.537, 0.0])
+            .collect();
+        let path = bolt_path(&locator, &pts, true).unwrap();
+        let at = |x: f64| locator.locate(&[x, 0.537], 1e-9).unwrap().element as u32;
+        let within = |k: usize, e: u32| {
+            let w = path.windows[k];
+            path.elements[w[0]..w[1]].contains(&e)
+        };
+        for (k, &(local, host)) in path.hosts.iter().enumerate() {
+            assert_eq!(path.elements[local] as usize, host.element);
+            assert!(within(k, host.element as u32), "node {k}");
+            // Two segments either way along the bolt, and no further.
+            let x = pts[k][0];
+            if k >= 2 {
+                assert!(within(k, at(x - 0.39)), "node {k} back");
+            }
+            if k + 2 <= 5 {
+                assert!(within(k, at(x + 0.39)), "node {k} on");
+            }
+            if k >= 3 {
+                assert!(!within(k, at(x - 0.61)), "node {k} too far back");
+            }
+        }
+        // The head reaches two segment lengths beyond itself, the tail too.
+        assert!(within(0, at(0.55 - 0.39)));
+        assert!(within(5, at(1.55 + 0.39)));
+        // Without re-location: the hosts only, each node's window its own host.
+        let fixed = bolt_path(&locator, &pts, false).unwrap();
+        for (k, w) in fixed.windows.iter().enumerate() {
+            assert_eq!(w[1] - w[0], 1, "node {k}");
+            assert_eq!(fixed.hosts[k].0, w[0]);
+        }
+    }
+
+    #[test]
+    fn path_nodes_are_shared_by_neighbouring_elements() {
+        let mesh = builders::rectangle(0.0, 0.0, 1.0, 1.0, 0.1).unwrap();
+        let locator = Locator::new(&mesh);
+        let pts = [[0.15, 0.537, 0.0], [0.85, 0.537, 0.0]];
+        let route = bolt_path::<Dim2>(&locator, &pts, true).unwrap();
+        let mut path: Vec<PathElement> = route
+            .elements
+            .iter()
+            .map(|&e| {
+                let mut pe = path_element(&mesh, e);
+                pe.node_range = [0, 2];
+                pe
+            })
+            .collect();
+        let mut pn = PathNodes::default();
+        let added = pn.add_bolt(2, &mut path, 0);
+        // Every corner maps to its mesh node, each mesh node once.
+        for pe in &path {
+            for q in 0..3 {
+                assert_eq!(pn.nodes[pe.local[q] as usize].node, pe.nodes[q]);
+            }
+        }
+        let mut seen: Vec<u32> = pn.nodes.iter().map(|p| p.node).collect();
+        seen.sort_unstable();
+        seen.dedup();
+        assert_eq!(seen.len(), added);
+        assert!(
+            added < 3 * path.len(),
+            "{added} nodes for {} elements",
+            path.len()
+        );
+        // Each (element, corner) pair is listed under its node exactly once.
+        let pairs: usize = pn
+            .nodes
+            .iter()
+            .map(|p| (p.refs[1] - p.refs[0]) as usize)
+            .sum();
+        assert_eq!(pairs, 3 * path.len());
     }
 }
