@@ -264,3 +264,62 @@ fn the_gpu_re_locates_as_the_cpu_2d_and_3d() {
     assert_ne!(c.field(BOLT_HOST).unwrap(), &hosts0[..], "nodes re-located");
     compare(&c, &g, "3D");
 }
+
+/// The pull of the first test seen from the bolt: the rock moves at 2 m/s along the
+/// bolt, the bolt's head held. The hosts are found from current positions, so the rock
+/// sliding past a held bolt re-locates its nodes as the bolt sliding through held rock
+/// does: the same hosts, grout forces and slips.
+#[test]
+fn rock_moving_past_a_held_bolt_re_locates_it_as_a_bolt_pulled_through_rock() {
+    let mesh = builders::rectangle(0.0, 0.0, 1.3, 0.4, 0.05).unwrap();
+    let ends = ([0.3, 0.2137, 0.0], [1.2, 0.2137, 0.0]);
+    let ramp = |v: f64| TimeValue::Table(Table::new("ramp", &[(0.0, 0.0), (1e-3, v)]).unwrap());
+    let mut pulled = scene(
+        mesh.clone(),
+        Backend::cpu(1).unwrap(),
+        ends,
+        9,
+        2.0,
+        true,
+        false,
+    );
+    let bolts = Bolts::new()
+        .bolt(Bolt::straight("B", ends.0, ends.1, 9, material()).unwrap())
+        .unwrap();
+    let held = bolts
+        .boundary()
+        .velocity("B", BoltNodes::Head, [Some(0.0.into()), None, None])
+        .unwrap()
+        .velocity("B", BoltNodes::All, [None, Some(0.0.into()), None])
+        .unwrap();
+    let mut moving = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+        .physics(
+            Mechanics::new().material(Range::All, LinearElastic::new(30e9, 0.25, 2700.0).unwrap()),
+        )
+        .physics(Boundary::new().velocity(Range::All, [Some(ramp(2.0)), Some(0.0.into()), None]))
+        .physics(bolts)
+        .physics(held)
+        .local_damping(0.3)
+        .build()
+        .unwrap();
+    assert_eq!(pulled.dt(), moving.dt());
+    pulled.run(19_000).unwrap();
+    moving.run(19_000).unwrap();
+    let hosts = moving.field(BOLT_HOST).unwrap();
+    assert_eq!(pulled.field(BOLT_HOST).unwrap(), hosts);
+    let first = moving.mesh().n_nodes();
+    for i in 0..hosts.len() {
+        let w = weight_in_host(&moving, i, first + i);
+        assert!(w >= -0.05, "node {i} lies outside its host: weight {w}");
+    }
+    for f in [BOLT_GROUT_FORCE, BOLT_SLIP] {
+        let (a, b) = (pulled.field(f).unwrap(), moving.field(f).unwrap());
+        let scale = a.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() <= 1e-9 * scale, "{f}: {x} vs {y}");
+        }
+    }
+    // It slid: every node changed host.
+    let slip = moving.field(BOLT_SLIP).unwrap();
+    assert!(slip.iter().all(|s| *s < -0.13), "{slip:?}");
+}
