@@ -82,11 +82,12 @@ pub(crate) fn bolts<D: Dim>(b: &Bolts, setup: &mut GpuSetup<'_, D>) -> Result<()
         slot += span.path_nodes as u32;
     }
     let mut node_u = Vec::with_capacity(6 * b.nodes.len());
-    let mut node_r = Vec::with_capacity(10 * b.nodes.len());
+    let mut node_r = Vec::with_capacity(11 * b.nodes.len());
     for (n, s) in b.nodes.iter().zip(&node_slot) {
         node_u.extend_from_slice(&[n.node, n.prev, n.next, n.cand[0], n.cand[1], *s]);
         node_r.extend_from_slice(&[n.k_axial, n.k_normal, n.bond_length, n.plate]);
         node_r.extend_from_slice(&n.bond);
+        node_r.push(n.c_lateral);
     }
     let mut path_u = Vec::with_capacity(5 * b.path.len());
     for pe in &b.path {
@@ -154,6 +155,7 @@ pub(crate) fn bolts<D: Dim>(b: &Bolts, setup: &mut GpuSetup<'_, D>) -> Result<()
         .const_u32("SLOT0", setup.slot_first())
         .bind("coords", setup.coords(), R)
         .bind("disp", setup.displacement(), R)
+        .bind("vel", setup.velocity(), R)
         .bind("bs_nodes", bs_nodes, R)
         .bind("bs_real", bs_real, R)
         .bind("bs_force", bs_force, R)

@@ -44,7 +44,10 @@
 //! Damping (eq. 148): F = D_b,f C (v_j − v_i)·e on each segment, C = 2 A_b √(E_b ρ_b)
 //! (\[CORRECTED\]: printed 2 L_b √(E_b ρ_b), which is not a damping coefficient in N·s/m;
 //! applied to the relative axial velocity of the segment's ends, not to the node's
-//! velocity, so that a bolt in a fragment in free flight is not braked).
+//! velocity, so that a bolt in a fragment in free flight is not braked); and across the
+//! axis at each node, F = D_b,f 2 √(k_n l m_n) (v_n − Σ_q w_q v_q)⊥, the same fraction of
+//! the critical damping of the node's lateral grout spring on its sideways velocity
+//! against the rock (\[NOT IN MANUAL\]; see "Sideways flutter" below).
 //!
 //! Face plate (\[NOT IN MANUAL\]): a one-sided spring at the head that pushes the head
 //! back out when the bolt pulls it into the rock, with the reaction into the rock.
@@ -60,20 +63,22 @@
 //! by √(1 + ζ²) − ζ for the axial damping; it enters the simulation's step like every
 //! other physics' limit and names the limiting bolt node.
 //!
-//! # Known limit: sideways flutter of a bolt sliding at its bond strength
+//! # Sideways flutter of a bolt sliding at its bond strength
 //!
 //! The grout force acts along the bolt's current axis at the node, the mean direction of
 //! its two segments. While a node slides at the bond strength that force has a fixed
 //! size and turns with the neighbouring nodes' sideways displacements: a follower force,
 //! which couples the bolt's lateral modes antisymmetrically and makes them grow slowly
 //! when nothing damps them. Seen (2026-12-07) in a 0.9 m rebar dragged 15 cm through a
-//! fixed block at 2 m/s with local damping 0.3 and the axial damping of eq. 148
-//! (D_b,f = 0.5): the nodes began to swing ±1 cm sideways after 6 000 to 12 000 steps
-//! (without re-location and with it), and the grout forces then changed sign. A pull-out of a few centimetres (the validation
-//! scenes) does not reach it. The growth rate is small (about the bond force over the
-//! segment length against the lateral grout stiffness), so any damping of the lateral
-//! grout motion would stop it; the model has none yet (the damping of eq. 148 acts on
-//! the segments' axial stretching rate only).
+//! fixed block at 2 m/s with local damping 0.3 and only the axial part of the damping
+//! above (D_b,f = 0.5): the nodes began to swing ±1 cm sideways after 6 000 to 12 000
+//! steps (without re-location and with it), and the grout forces then changed sign. The
+//! growth rate is small (about the bond force over the segment length against the
+//! lateral grout stiffness), so the lateral part of the damping stops it: with it the
+//! same bolt stays on the plateau all the way (test
+//! `an_inclined_bolt_dragged_at_its_bond_strength_does_not_flutter`). The default
+//! D_b,f is 0 (the manual's); give a bolt that will slide far a damping factor. A
+//! pull-out of a few centimetres (the validation scenes, undamped) does not reach it.
 //!
 //! # Composing
 //!

@@ -55,8 +55,11 @@ pub struct BoltProperties {
     /// (ungrouted) length ([`crate::Bolt::free_length`]).
     #[serde(default)]
     pub pretension: f64,
-    /// Axial damping factor D_b,f (-, ≥ 0, eq. 148): the fraction of the damping
-    /// coefficient C = 2 A_b √(E_b ρ_b).
+    /// Damping factor D_b,f (-, ≥ 0, eq. 148): the fraction of the axial damping
+    /// coefficient C = 2 A_b √(E_b ρ_b) on each segment's stretching rate, and of the
+    /// critical damping 2 √(k_n l m) of each bolt node's lateral grout spring on its
+    /// sideways velocity against the rock (\[NOT IN MANUAL\]; it stops the sideways
+    /// flutter a bolt sliding at its bond strength can develop, see the crate docs).
     #[serde(default)]
     pub damping_factor: f64,
 }
@@ -257,6 +260,7 @@ impl BoltMaterial {
             mass_per_length: p.density * a / s,
             pretension: p.pretension / s,
             damping: p.damping_factor * 2.0 * a * (p.young * p.density).sqrt() / s,
+            damping_factor: p.damping_factor,
             bond_per_spacing: 1.0 / s,
         }
     }
@@ -276,6 +280,8 @@ pub(crate) struct Effective {
     pub pretension: f64,
     /// Axial damping coefficient D_b,f · 2 A_b √(E_b ρ_b) (N·s/m).
     pub damping: f64,
+    /// D_b,f (-), for the lateral grout damping.
+    pub damping_factor: f64,
     /// The factor the bond strength per length is multiplied by (1 / spacing).
     pub bond_per_spacing: f64,
 }

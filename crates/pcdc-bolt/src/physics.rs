@@ -41,6 +41,8 @@ pub(crate) struct BoltNode {
     pub k_axial: f64,
     /// Lateral grout stiffness × l (N/m).
     pub k_normal: f64,
+    /// Lateral grout damping D_b,f · 2 √(k_normal m) (N·s/m), 0 without damping.
+    pub c_lateral: f64,
     /// Tributary length over the spacing (m): bond capacity = S_b(σn) × this.
     pub bond_length: f64,
     /// The bond capacity without confinement, S_b(0) × `bond_length` (N): the capacity
@@ -315,6 +317,9 @@ impl Bolts {
                     cand: [(path0 + window[0]) as u32, (path0 + window[1]) as u32],
                     k_axial: if grouted { eff.shear * l } else { 0.0 },
                     k_normal: eff.normal * l,
+                    c_lateral: eff.damping_factor
+                        * 2.0
+                        * (eff.normal * l * eff.mass_per_length * l).sqrt(),
                     bond_length: l * eff.bond_per_spacing,
                     cap_unconfined: crate::material::bond_strength(&bond, 0.0)
                         * (l * eff.bond_per_spacing),
@@ -498,10 +503,10 @@ impl<D: Dim> Physics<D> for Bolts {
 
     fn stable_step(&self, _kin: &Kinematics<'_, D>, _fields: &FieldStore) -> Option<StableStep> {
         // Gershgorin per bolt node (hosts taken as fixed): ω² ≤ (Σ 2 EA/L₀ + k_grout +
-        // k_plate) / m; axial damping lowers the step by √(1 + ζ²) − ζ.
+        // k_plate) / m; axial and lateral damping lower the step by √(1 + ζ²) − ζ.
         let mut best: Option<StableStep> = None;
         for (i, n) in self.nodes.iter().enumerate() {
-            let (mut k, mut c) = (n.k_axial.max(n.k_normal) + n.plate, 0.0);
+            let (mut k, mut c) = (n.k_axial.max(n.k_normal) + n.plate, n.c_lateral);
             for s in [n.prev, n.next] {
                 if s != NONE {
                     let seg = &self.segments[s as usize];

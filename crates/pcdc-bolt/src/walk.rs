@@ -68,6 +68,14 @@ fn disp<D: Dim>(kin: &Kinematics<'_, D>, n: u32) -> [f64; 3] {
     u
 }
 
+/// Velocity of node `n` (m/s; z = 0 in 2D).
+fn vel<D: Dim>(kin: &Kinematics<'_, D>, n: u32) -> [f64; 3] {
+    let d = D::D;
+    let mut v = [0.0; 3];
+    v[..d].copy_from_slice(&kin.v[n as usize * d..n as usize * d + d]);
+    v
+}
+
 /// A segment's current unit direction and elongation L − L₀ (m), the latter as
 /// (2 ΔX·Δu + Δu·Δu) / (L + L₀) from the displacements, so that it keeps its digits
 /// where L − L₀ from positions would cancel (a stiff bar's force would carry E A / L₀
@@ -442,6 +450,18 @@ impl Walk<'_> {
         *out.grout = fs;
         // Lateral grout, and the face plate (one-sided, pushes the head back out).
         let mut g: [f64; 3] = std::array::from_fn(|k| fs * a[k] + n.k_normal * lateral[k]);
+        if n.c_lateral > 0.0 {
+            // Lateral damping on the node's sideways velocity against the rock.
+            let mut w = [0.0; 3];
+            let vn = vel(kin, n.node);
+            for q in 0..=d {
+                let vq = vel(kin, active.nodes[q]);
+                (0..3).for_each(|k| w[k] += anchor[1 + q] * vq[k]);
+            }
+            let vr: [f64; 3] = std::array::from_fn(|k| vn[k] - w[k]);
+            let va = vr[0] * a[0] + vr[1] * a[1] + vr[2] * a[2];
+            (0..3).for_each(|k| g[k] += n.c_lateral * (vr[k] - va * a[k]));
+        }
         if n.plate > 0.0 && delta > 0.0 {
             (0..3).for_each(|k| g[k] += n.plate * delta * a[k]);
         }

@@ -323,3 +323,39 @@ fn rock_moving_past_a_held_bolt_re_locates_it_as_a_bolt_pulled_through_rock() {
     let slip = moving.field(BOLT_SLIP).unwrap();
     assert!(slip.iter().all(|s| *s < -0.13), "{slip:?}");
 }
+
+/// An inclined bolt, free to move sideways, dragged three elements at its bond strength:
+/// with the grout's lateral damping (D_b,f = 0.5) it stays on the plateau all the way
+/// (without it the nodes began to swing sideways after 6 000 to 12 000 steps and the
+/// grout forces changed sign: a follower force's flutter, see the crate docs).
+#[test]
+fn an_inclined_bolt_dragged_at_its_bond_strength_does_not_flutter() {
+    let mesh = builders::rectangle(0.0, 0.0, 1.3, 0.4, 0.05).unwrap();
+    let ends = ([0.3, 0.213, 0.0], [1.2, 0.171, 0.0]);
+    let mut sim = scene(mesh, Backend::cpu(1).unwrap(), ends, 9, 2.0, false, false);
+    let length = (0.9f64 * 0.9 + 0.042 * 0.042).sqrt();
+    let capacity = material().bond_strength(0.0) * length;
+    let first = sim.mesh().n_nodes();
+    let mut swing: f64 = 0.0;
+    while sim.kinematics().time < 0.076 {
+        sim.run(200).unwrap();
+        if sim.kinematics().time > 0.02 {
+            let total: f64 = sim.field(BOLT_GROUT_FORCE).unwrap().iter().sum();
+            assert!(
+                ((-total - capacity) / capacity).abs() < 1e-9,
+                "t = {}: {total} vs {capacity}",
+                sim.kinematics().time
+            );
+        }
+        // Sideways displacement of each node off the bolt's line.
+        let (a, b) = (ends.0, ends.1);
+        let (ex, ey) = ((b[0] - a[0]) / length, (b[1] - a[1]) / length);
+        for i in 0..10 {
+            let u = &sim.kinematics().u[(first + i) * 2..(first + i) * 2 + 2];
+            swing = swing.max((-ey * u[0] + ex * u[1]).abs());
+        }
+    }
+    assert!(swing < 1e-4, "sideways {swing} m");
+    let slip = sim.field(BOLT_SLIP).unwrap();
+    assert!(slip.iter().all(|s| *s < -0.13), "{slip:?}");
+}

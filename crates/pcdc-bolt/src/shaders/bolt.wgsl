@@ -10,7 +10,8 @@
 // bs_nodes: 2 nodes per segment; bs_real (BS_STRIDE = 9 per segment): l0, EA, f_t, f_c,
 // ε_f, damping, reference vector ΔX;
 // bn_u32 (6 per bolt node): node, prev, next, first and end candidate (path index), slot;
-// bn_real (10 per node): k_axial, k_normal, bond length, plate, 6 bond constants;
+// bn_real (11 per node): k_axial, k_normal, bond length, plate, 6 bond constants, lateral
+// damping;
 // bp_u32 (5 per path element): element, 4 nodes;
 // bq_u32 (5 per path node): slot, first and end bolt node that may add to it, first and
 // end of its (path element, corner) pairs in bq_refs;
@@ -346,7 +347,7 @@ fn kernel(i: u32) {
     let c0 = bn_u32[6u * i + 3u];
     let c1 = bn_u32[6u * i + 4u];
     let slot = bn_u32[6u * i + 5u];
-    let r0 = 10u * i;
+    let r0 = 11u * i;
     let k_axial = bn_real[r0];
     let k_normal = bn_real[r0 + 1u];
     let bond_length = bn_real[r0 + 2u];
@@ -420,6 +421,26 @@ fn kernel(i: u32) {
     var g: array<Real, 3>;
     for (var k = 0u; k < 3u; k = k + 1u) {
         g[k] = fs * a[k] + k_normal * lateral[k];
+    }
+    let c_lateral = bn_real[r0 + 10u];
+    if c_lateral > 0.0 {
+        // Lateral damping on the node's sideways velocity against the rock.
+        var w = array<Real, 3>(0.0, 0.0, 0.0);
+        let h = path_nodes(j);
+        for (var q = 0u; q <= D; q = q + 1u) {
+            let wq = bolt_anchor[a0 + 1u + q];
+            for (var k = 0u; k < D; k = k + 1u) {
+                w[k] = w[k] + wq * vel[h[q] * D + k];
+            }
+        }
+        var vr = array<Real, 3>(0.0, 0.0, 0.0);
+        for (var k = 0u; k < D; k = k + 1u) {
+            vr[k] = vel[node * D + k] - w[k];
+        }
+        let va = vr[0] * a[0] + vr[1] * a[1] + vr[2] * a[2];
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            g[k] = g[k] + c_lateral * (vr[k] - va * a[k]);
+        }
     }
     if plate > 0.0 && delta > 0.0 {
         for (var k = 0u; k < 3u; k = k + 1u) {
