@@ -715,45 +715,36 @@ impl<D: Dim> Simulation<D> {
         let fields = &mut self.state.fields;
         let backend = &self.backend;
         let mut beside = self.beside.as_deref_mut();
-        let mut slots_rest: &mut [f64] = &mut self.slot_forces;
-        let mut taken = 0;
-        // Each physics' slot block, in order (the ranges are consecutive).
-        let mut blocks: Vec<Option<&mut [f64]>> = Vec::with_capacity(self.slot_ranges.len());
-        for r in &self.slot_ranges {
-            let (block, rest) = std::mem::take(&mut slots_rest).split_at_mut((r.end - taken) * d);
-            let (_, block) = block.split_at_mut((r.start - taken) * d);
-            slots_rest = rest;
-            taken = r.end;
-            blocks.push(Some(block));
-        }
-        let mut physics: Vec<Option<&mut Box<dyn Physics<D>>>> =
-            self.physics.iter_mut().map(Some).collect();
-        for i in 0..physics.len() {
+        for i in 0..self.physics.len() {
             if beside.as_ref().is_some_and(|b| b.skip[i]) {
                 continue;
             }
-            let partner = beside.as_ref().and_then(|b| b.partner[i]);
-            let (Some(p), Some(slots)) = (physics[i].take(), blocks[i].take()) else {
-                continue;
-            };
-            if !p.writes_all_slots() {
-                slots.fill(0.0);
-            }
-            let Some(l) = partner else {
-                let mut ctx = ForceContext {
+            let r = self.slot_ranges[i].clone();
+            let Some(l) = beside.as_ref().and_then(|b| b.partner[i]) else {
+                let p = &mut self.physics[i];
+                let slots = &mut self.slot_forces[r.start * d..r.end * d];
+                if !p.writes_all_slots() {
+                    slots.fill(0.0);
+                }
+                p.compute_forces(&mut ForceContext {
                     kin: kin(),
                     fields,
                     slots,
                     backend,
-                };
-                p.compute_forces(&mut ctx)?;
+                })?;
                 continue;
             };
-            let (Some(q), Some(q_slots)) = (physics[l].take(), blocks[l].take()) else {
-                continue;
-            };
-            if !q.writes_all_slots() {
-                q_slots.fill(0.0);
+            // The partner comes later (l > i): its physics and slots lie past the split.
+            let rl = self.slot_ranges[l].clone();
+            let (before, after) = self.physics.split_at_mut(l);
+            let (p, q) = (&mut before[i], &mut after[0]);
+            let (lo, hi) = self.slot_forces.split_at_mut(rl.start * d);
+            let slots = &mut lo[r.start * d..r.end * d];
+            let q_slots = &mut hi[..(rl.end - rl.start) * d];
+            for (x, s) in [(&*p, &mut *slots), (&*q, &mut *q_slots)] {
+                if !x.writes_all_slots() {
+                    s.fill(0.0);
+                }
             }
             let side = beside.as_deref_mut().expect("a partner comes from a plan");
             side.swap(fields, l);
