@@ -108,6 +108,25 @@ pub(crate) struct BoltPath {
 /// the tail, in lengths of the end segment).
 pub(crate) const REACH: usize = 2;
 
+/// The elements found along a path, in the order found, and each one's index.
+#[derive(Default)]
+struct Found {
+    list: Vec<u32>,
+    index: std::collections::HashMap<usize, usize>,
+}
+
+impl Found {
+    /// The path index of element `e`, added at the end if new (a long cable meets
+    /// thousands, so not a linear search).
+    fn index(&mut self, e: usize) -> usize {
+        let list = &mut self.list;
+        *self.index.entry(e).or_insert_with(|| {
+            list.push(e as u32);
+            list.len() - 1
+        })
+    }
+}
+
 /// Samples per element size along the path (an element the path only clips at a corner
 /// may be missed; a node passing through it is re-found in the next one).
 const SAMPLES_PER_CELL: f64 = 4.0;
@@ -121,16 +140,7 @@ pub(crate) fn bolt_path<D: Dim>(
     relocate: bool,
 ) -> Result<BoltPath, usize> {
     let d = D::D;
-    let mut elements: Vec<u32> = Vec::new();
-    let index_of = |e: usize, elements: &mut Vec<u32>| -> usize {
-        match elements.iter().position(|&x| x as usize == e) {
-            Some(i) => i,
-            None => {
-                elements.push(e as u32);
-                elements.len() - 1
-            }
-        }
-    };
+    let mut elements = Found::default();
     // The nodes' hosts first, so that each is on the path whatever the sampling finds.
     let mut hosts = Vec::with_capacity(points.len());
     for (k, p) in points.iter().enumerate() {
@@ -142,7 +152,7 @@ pub(crate) fn bolt_path<D: Dim>(
     // host), REACH lengths beyond the tail; each stretch as the range of path indices it
     // found, so that every node's candidates are contiguous and near each other.
     let step = locator.cell() / SAMPLES_PER_CELL;
-    let sample = |a: [f64; 3], b: [f64; 3], elements: &mut Vec<u32>| -> [usize; 2] {
+    let sample = |a: [f64; 3], b: [f64; 3], elements: &mut Found| -> [usize; 2] {
         if !relocate {
             return [usize::MAX, 0];
         }
@@ -153,7 +163,7 @@ pub(crate) fn bolt_path<D: Dim>(
             let t = i as f64 / n as f64;
             let p: Vec<f64> = (0..d).map(|k| a[k] + t * (b[k] - a[k])).collect();
             if let Some(h) = locator.locate(&p, 1e-9) {
-                let j = index_of(h.element, elements);
+                let j = elements.index(h.element);
                 range = [range[0].min(j), range[1].max(j + 1)];
             }
         }
@@ -169,12 +179,12 @@ pub(crate) fn bolt_path<D: Dim>(
         head = sample(beyond(points[0], points[1]), points[0], &mut elements);
     }
     let mut host_index = vec![0usize; points.len()];
-    host_index[0] = index_of(hosts[0].element, &mut elements);
+    host_index[0] = elements.index(hosts[0].element);
     head = join(head, [host_index[0], host_index[0] + 1]);
     let mut seg_range: Vec<[usize; 2]> = Vec::with_capacity(last);
     for s in 0..last {
         let r = sample(points[s], points[s + 1], &mut elements);
-        let j = index_of(hosts[s + 1].element, &mut elements);
+        let j = elements.index(hosts[s + 1].element);
         host_index[s + 1] = j;
         let ends = [host_index[s].min(j), host_index[s].max(j) + 1];
         seg_range.push(join(r, ends));
@@ -208,7 +218,7 @@ pub(crate) fn bolt_path<D: Dim>(
         })
         .collect();
     Ok(BoltPath {
-        elements,
+        elements: elements.list,
         windows,
         hosts: host_index.into_iter().zip(hosts).collect(),
     })

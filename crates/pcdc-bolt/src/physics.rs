@@ -87,9 +87,6 @@ pub struct Bolts {
     /// First bolt-node and segment index of each bolt.
     node_offset: Vec<usize>,
     segment_offset: Vec<usize>,
-    /// [`BOLT_ANCHOR`] and [`BOLT_HOST`] as found in the reference mesh.
-    anchor0: Vec<f64>,
-    host0: Vec<f64>,
     pub(crate) ids: Option<Ids>,
     /// The first bolt of each work block (see [`crate::walk::blocks`]): the unit of
     /// parallel work.
@@ -149,8 +146,6 @@ impl Bolts {
             spans: Vec::new(),
             node_offset: Vec::new(),
             segment_offset: Vec::new(),
-            anchor0: Vec::new(),
-            host0: Vec::new(),
             ids: None,
             blocks: Vec::new(),
             blocking: (PARALLEL_FROM, BLOCK_NODES),
@@ -223,7 +218,12 @@ impl Bolts {
 
     /// Builds segments, nodes and the paths' elements (hosts located in the reference
     /// mesh).
-    fn build<D: Dim>(&mut self, mesh: &Mesh<D>, first: usize) -> Result<(), BoltError> {
+    /// Returns the initial [`BOLT_ANCHOR`] and [`BOLT_HOST`] values.
+    fn build<D: Dim>(
+        &mut self,
+        mesh: &Mesh<D>,
+        first: usize,
+    ) -> Result<(Vec<f64>, Vec<f64>), BoltError> {
         let d = D::D;
         let two_d = d == 2;
         let locator = Locator::new(mesh);
@@ -234,8 +234,7 @@ impl Bolts {
         self.spans.clear();
         self.node_offset.clear();
         self.segment_offset.clear();
-        self.anchor0.clear();
-        self.host0.clear();
+        let (mut anchor0, mut host0) = (Vec::new(), Vec::new());
         let mut node = first as u32;
         let mut x = vec![0.0; (d + 1) * d];
         for bolt in &self.bolts {
@@ -304,13 +303,12 @@ impl Bolts {
                     .iter()
                     .cloned()
                     .fold(f64::INFINITY, f64::min);
-                self.anchor0.push((local - window[0]) as f64);
-                self.anchor0.extend_from_slice(&host.weights[..=d]);
-                self.anchor0.extend(std::iter::repeat_n(0.0, d));
-                self.anchor0
-                    .push(walk::margin(wmin, crate::host::min_height(d, &x)));
-                self.anchor0.push(0.0);
-                self.host0.push(host.element as f64);
+                anchor0.push((local - window[0]) as f64);
+                anchor0.extend_from_slice(&host.weights[..=d]);
+                anchor0.extend(std::iter::repeat_n(0.0, d));
+                anchor0.push(walk::margin(wmin, crate::host::min_height(d, &x)));
+                anchor0.push(0.0);
+                host0.push(host.element as f64);
                 let bond = bolt.material().bond_constants();
                 self.nodes.push(BoltNode {
                     node: node + k as u32,
@@ -340,7 +338,7 @@ impl Bolts {
             }
             node += n as u32;
         }
-        Ok(())
+        Ok((anchor0, host0))
     }
 
     /// Whether segment `s` lies in its bolt's free length (its midpoint does).
@@ -402,7 +400,7 @@ impl<D: Dim> Physics<D> for Bolts {
         }
         let d = D::D;
         let first = ctx.n_nodes();
-        self.build(ctx.mesh, first)?;
+        let (anchor0, host0) = self.build(ctx.mesh, first)?;
         let mut coords = Vec::with_capacity(self.nodes.len() * d);
         for b in &self.bolts {
             for p in b.points() {
@@ -450,17 +448,15 @@ impl<D: Dim> Physics<D> for Bolts {
             }
         }
         ctx.fields.get_mut(ids.plastic).copy_from_slice(&plastic);
-        ctx.fields
-            .get_mut(ids.anchor)
-            .copy_from_slice(&self.anchor0);
-        ctx.fields.get_mut(ids.host).copy_from_slice(&self.host0);
+        ctx.fields.get_mut(ids.anchor).copy_from_slice(&anchor0);
+        ctx.fields.get_mut(ids.host).copy_from_slice(&host0);
         let alen = anchor_len(d);
         self.active = self
             .nodes
             .iter()
             .enumerate()
             .map(|(i, n)| {
-                let j = n.cand[0] as usize + self.anchor0[i * alen] as usize;
+                let j = n.cand[0] as usize + anchor0[i * alen] as usize;
                 Active::of(j, &self.path[j])
             })
             .collect();
@@ -481,8 +477,9 @@ impl<D: Dim> Physics<D> for Bolts {
         let q = 2.0 * t * t / 4.0;
         let d = D::D;
         let alen = anchor_len(d);
-        // The current hosts (those found in the reference mesh before init).
-        let anchor = self.ids.map_or(&self.anchor0[..], |ids| f.get(ids.anchor));
+        // The current hosts (init has run: the engine lumps masses after it).
+        let Some(ids) = self.ids else { return };
+        let anchor = f.get(ids.anchor);
         for (i, n) in self.nodes.iter().enumerate() {
             let a = &anchor[i * alen..(i + 1) * alen];
             let host = &self.path[n.cand[0] as usize + a[0] as usize];

@@ -567,27 +567,37 @@ impl Bolts {
 
 /// Cuts `whole` before the blocks' first bolts (`d` dimensions).
 fn split_blocks<'a>(mut rest: Block<'a>, blocks: &[usize], d: usize) -> Vec<Block<'a>> {
-    let alen = crate::anchor_len(d);
     let mut out = Vec::with_capacity(blocks.len());
     for w in blocks.windows(2) {
-        let (spans, spans_r) = rest.spans.split_at(w[1] - w[0]);
+        let (head, tail) = rest.split(w[1] - w[0], d);
+        out.push(head);
+        rest = tail;
+    }
+    out.push(rest);
+    out
+}
+
+impl<'a> Block<'a> {
+    /// This block's first `bolts` bolts, and the rest (`d` dimensions).
+    fn split(self, bolts: usize, d: usize) -> (Block<'a>, Block<'a>) {
+        let (spans, spans_r) = self.spans.split_at(bolts);
         let sum = |f: fn(&Span) -> usize| spans.iter().map(f).sum::<usize>();
         let (n, s) = (sum(|x| x.nodes), sum(|x| x.segments));
         let slots_n = n + sum(|x| x.path_nodes);
-        let (axial, axial_r) = std::mem::take(&mut rest.axial).split_at_mut(s);
-        let (plastic, plastic_r) = std::mem::take(&mut rest.plastic).split_at_mut(s);
-        let (state, state_r) = std::mem::take(&mut rest.state).split_at_mut(s);
-        let (grout, grout_r) = std::mem::take(&mut rest.grout).split_at_mut(n);
-        let (slip, slip_r) = std::mem::take(&mut rest.slip).split_at_mut(n);
-        let (anchor, anchor_r) = std::mem::take(&mut rest.anchor).split_at_mut(n * alen);
-        let (host, host_r) = std::mem::take(&mut rest.host).split_at_mut(n);
-        let (active, active_r) = std::mem::take(&mut rest.active).split_at_mut(n);
-        let (slots, slots_r) = std::mem::take(&mut rest.slots).split_at_mut(slots_n * d);
-        let (segments, segments_r) = rest.segments.split_at(s);
-        let (nodes, nodes_r) = rest.nodes.split_at(n);
-        out.push(Block {
+        let (axial, axial_r) = self.axial.split_at_mut(s);
+        let (plastic, plastic_r) = self.plastic.split_at_mut(s);
+        let (state, state_r) = self.state.split_at_mut(s);
+        let (grout, grout_r) = self.grout.split_at_mut(n);
+        let (slip, slip_r) = self.slip.split_at_mut(n);
+        let (anchor, anchor_r) = self.anchor.split_at_mut(n * crate::anchor_len(d));
+        let (host, host_r) = self.host.split_at_mut(n);
+        let (active, active_r) = self.active.split_at_mut(n);
+        let (slots, slots_r) = self.slots.split_at_mut(slots_n * d);
+        let (segments, segments_r) = self.segments.split_at(s);
+        let (nodes, nodes_r) = self.nodes.split_at(n);
+        let head = Block {
             spans,
-            first_segment: rest.first_segment,
+            first_segment: self.first_segment,
             segments,
             nodes,
             axial,
@@ -599,10 +609,10 @@ fn split_blocks<'a>(mut rest: Block<'a>, blocks: &[usize], d: usize) -> Vec<Bloc
             host,
             active,
             slots,
-        });
-        rest = Block {
+        };
+        let tail = Block {
             spans: spans_r,
-            first_segment: rest.first_segment + s,
+            first_segment: self.first_segment + s,
             segments: segments_r,
             nodes: nodes_r,
             axial: axial_r,
@@ -615,7 +625,6 @@ fn split_blocks<'a>(mut rest: Block<'a>, blocks: &[usize], d: usize) -> Vec<Bloc
             active: active_r,
             slots: slots_r,
         };
+        (head, tail)
     }
-    out.push(rest);
-    out
 }

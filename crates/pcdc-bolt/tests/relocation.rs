@@ -221,48 +221,39 @@ fn the_gpu_re_locates_as_the_cpu_2d_and_3d() {
     };
     let m2: Mesh<Dim2> = builders::rectangle(0.0, 0.0, 1.0, 0.3, 0.1).unwrap();
     let e2 = ([0.3, 0.163, 0.0], [0.9, 0.121, 0.0]);
-    let run = |backend: Backend| {
-        let mut s = scene(m2.clone(), backend, e2, 6, 20.0, false, false);
+    gpu_against_cpu(&m2, &gpu, e2, 6, 20.0, "2D");
+    let m3: Mesh<Dim3> = builders::cuboid([0.0; 3], [0.6, 0.6, 1.0], 0.2).unwrap();
+    let e3 = ([0.27, 0.33, 0.9], [0.35, 0.21, 0.15]);
+    gpu_against_cpu(&m3, &gpu, e3, 5, 40.0, "3D");
+}
+
+/// The pull of [`scene`] for 1 500 steps on the CPU and on `gpu`: some node changes host,
+/// and both backends agree ([`compare`]).
+fn gpu_against_cpu<D: Dim>(
+    mesh: &Mesh<D>,
+    gpu: &Backend,
+    ends: ([f64; 3], [f64; 3]),
+    segments: usize,
+    speed: f64,
+    what: &str,
+) {
+    let build = |b: Backend| scene(mesh.clone(), b, ends, segments, speed, false, false);
+    let hosts0 = build(Backend::cpu(1).unwrap())
+        .field(BOLT_HOST)
+        .unwrap()
+        .to_vec();
+    let run = |b: Backend| {
+        let mut s = build(b);
         s.run(1500).unwrap();
         s
     };
     let (c, g) = (run(Backend::cpu(1).unwrap()), run(gpu.clone()));
-    let hosts0 = scene(
-        m2.clone(),
-        Backend::cpu(1).unwrap(),
-        e2,
-        6,
-        20.0,
-        false,
-        false,
-    )
-    .field(BOLT_HOST)
-    .unwrap()
-    .to_vec();
-    assert_ne!(c.field(BOLT_HOST).unwrap(), &hosts0[..], "nodes re-located");
-    compare(&c, &g, "2D");
-    let m3: Mesh<Dim3> = builders::cuboid([0.0; 3], [0.6, 0.6, 1.0], 0.2).unwrap();
-    let e3 = ([0.27, 0.33, 0.9], [0.35, 0.21, 0.15]);
-    let run = |backend: Backend| {
-        let mut s = scene(m3.clone(), backend, e3, 5, 40.0, false, false);
-        s.run(1500).unwrap();
-        s
-    };
-    let (c, g) = (run(Backend::cpu(1).unwrap()), run(gpu));
-    let hosts0 = scene(
-        m3.clone(),
-        Backend::cpu(1).unwrap(),
-        e3,
-        5,
-        40.0,
-        false,
-        false,
-    )
-    .field(BOLT_HOST)
-    .unwrap()
-    .to_vec();
-    assert_ne!(c.field(BOLT_HOST).unwrap(), &hosts0[..], "nodes re-located");
-    compare(&c, &g, "3D");
+    assert_ne!(
+        c.field(BOLT_HOST).unwrap(),
+        &hosts0[..],
+        "{what}: nodes re-located"
+    );
+    compare(&c, &g, what);
 }
 
 /// The pull of the first test seen from the bolt: the rock moves at 2 m/s along the
