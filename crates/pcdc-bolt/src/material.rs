@@ -47,8 +47,9 @@ pub struct BoltProperties {
     pub friction_rock_grout: f64,
     /// Friction angle of the grout-bolt interface φ_b,g (degrees, in [0, 90)).
     pub friction_grout_bolt: f64,
-    /// Out-of-plane spacing of a bolt row in 2D (m, > 0); `None` in 3D and for a single
-    /// bolt per metre in 2D (spacing 1 m).
+    /// Out-of-plane spacing of a bolt row in 2D (m, > 0); `None` in 3D, and in 2D one
+    /// bolt per unit of thickness: spacing 1 in the model's length unit (1 m in SI, but
+    /// 1 mm in a millimetre model, where a row 1 m apart needs `Some(1000.0)`).
     #[serde(default)]
     pub spacing: Option<f64>,
     /// Pretension f_b,pre (N, ≥ 0), carried by the segments of the bolt's free

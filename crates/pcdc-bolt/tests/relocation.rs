@@ -350,3 +350,91 @@ fn an_inclined_bolt_dragged_at_its_bond_strength_does_not_flutter() {
     let slip = sim.field(BOLT_SLIP).unwrap();
     assert!(slip.iter().all(|s| *s < -0.13), "{slip:?}");
 }
+
+/// The first test's pull on an unstructured mesh (a disc of rings of triangles), in SI
+/// and in millimetre–newton–second–tonne units: every node is re-found inside its host
+/// in both, the hosts are the same, and the grout forces and slips agree after
+/// conversion (re-location uses barycentric weights and element heights only, so no
+/// unit and no mesh pattern is built in).
+#[test]
+fn re_location_is_the_same_on_an_unstructured_mesh_in_any_units() {
+    // l: length unit (m), s: stress unit (Pa), m: mass unit (kg); force unit s l².
+    let run = |l: f64, s: f64, m: f64| {
+        let f = s * l * l;
+        let mesh = builders::disc([0.7 / l, 0.2 / l], 0.6 / l, 0.05 / l).unwrap();
+        let p = BoltProperties::steel_rebar(0.025);
+        let props = BoltProperties {
+            density: p.density / (m / (l * l * l)),
+            young: p.young / s,
+            diameter: p.diameter / l,
+            tensile_yield_force: p.tensile_yield_force / f,
+            compressive_yield_force: p.compressive_yield_force / f,
+            shear_stiffness: p.shear_stiffness / s,
+            grout_thickness: p.grout_thickness / l,
+            cohesion_rock_grout: 0.2e6 / s,
+            cohesion_grout_bolt: p.cohesion_grout_bolt / s,
+            friction_rock_grout: 0.0,
+            friction_grout_bolt: 0.0,
+            damping_factor: 0.5,
+            // One bolt per metre of thickness (the default is one per length unit).
+            spacing: Some(1.0 / l),
+            ..p
+        };
+        let (head, tail) = ([0.3 / l, 0.2137 / l, 0.0], [1.2 / l, 0.2137 / l, 0.0]);
+        let bolts = Bolts::new()
+            .bolt(Bolt::straight("B", head, tail, 9, BoltMaterial::new(props).unwrap()).unwrap())
+            .unwrap();
+        let ramp = TimeValue::Table(Table::new("pull", &[(0.0, 0.0), (1e-3, -2.0 / l)]).unwrap());
+        let pull = bolts
+            .boundary()
+            .velocity("B", BoltNodes::Head, [Some(ramp), None, None])
+            .unwrap()
+            .velocity("B", BoltNodes::All, [None, Some(0.0.into()), None])
+            .unwrap();
+        let rock = LinearElastic::new(30e9 / s, 0.25, 2700.0 / (m / (l * l * l))).unwrap();
+        let mut sim = Simulation::builder(mesh, Backend::cpu(1).unwrap())
+            .physics(Mechanics::new().material(Range::All, rock))
+            .physics(Boundary::new().fix(Range::All))
+            .physics(bolts)
+            .physics(pull)
+            .local_damping(0.3)
+            .build()
+            .unwrap();
+        let hosts0 = sim.field(BOLT_HOST).unwrap().to_vec();
+        sim.run_until(0.076).unwrap();
+        let first = sim.mesh().n_nodes();
+        for i in 0..hosts0.len() {
+            let w = weight_in_host(&sim, i, first + i);
+            assert!(w >= -0.05, "node {i} lies outside its host: weight {w}");
+        }
+        let hosts = sim.field(BOLT_HOST).unwrap().to_vec();
+        assert!(hosts.iter().zip(&hosts0).all(|(a, b)| a != b), "{hosts:?}");
+        let per_m = f / l;
+        let grout: Vec<f64> = sim
+            .field(BOLT_GROUT_FORCE)
+            .unwrap()
+            .iter()
+            .map(|g| g * per_m)
+            .collect();
+        let slip: Vec<f64> = sim
+            .field(BOLT_SLIP)
+            .unwrap()
+            .iter()
+            .map(|x| x * l)
+            .collect();
+        (hosts, grout, slip)
+    };
+    let si = run(1.0, 1.0, 1.0);
+    let mm = run(1e-3, 1e6, 1e3);
+    assert_eq!(si.0, mm.0, "hosts");
+    for (what, a, b) in [("grout force", &si.1, &mm.1), ("slip", &si.2, &mm.2)] {
+        let scale = a.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        let worst = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-9 * scale, "{what}: {worst} of {scale}");
+    }
+    assert!(si.2.iter().all(|s| *s < -0.13), "slid: {:?}", si.2);
+}
