@@ -84,8 +84,7 @@ pub struct Bolts {
     pub(crate) path_nodes: PathNodes,
     /// Nodes, segments and path nodes of each bolt.
     pub(crate) spans: Vec<Span>,
-    /// First bolt-node and segment index of each bolt.
-    node_offset: Vec<usize>,
+    /// First segment index of each bolt.
     segment_offset: Vec<usize>,
     pub(crate) ids: Option<Ids>,
     /// The first bolt of each work block (see [`crate::walk::blocks`]): the unit of
@@ -144,7 +143,6 @@ impl Bolts {
             path: Vec::new(),
             path_nodes: PathNodes::default(),
             spans: Vec::new(),
-            node_offset: Vec::new(),
             segment_offset: Vec::new(),
             ids: None,
             blocks: Vec::new(),
@@ -232,7 +230,6 @@ impl Bolts {
         self.path.clear();
         self.path_nodes = PathNodes::default();
         self.spans.clear();
-        self.node_offset.clear();
         self.segment_offset.clear();
         let (mut anchor0, mut host0) = (Vec::new(), Vec::new());
         let mut node = first as u32;
@@ -264,7 +261,6 @@ impl Bolts {
                 segments: n - 1,
                 path_nodes: 0,
             });
-            self.node_offset.push(self.nodes.len());
             self.segment_offset.push(self.segments.len());
             let seg0 = self.segments.len() as u32;
             for s in 0..n - 1 {
