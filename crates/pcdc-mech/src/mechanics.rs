@@ -27,8 +27,10 @@ use rayon::prelude::*;
 use crate::initial_stress::InitialStress;
 use crate::kinematics::{dm_inv_2d, polar_2d_h, polar_3d};
 use crate::mixed::{trace_2d, MixedCells};
-use crate::model::{add_hooke, double_dot, ConstitutiveModel, LinearElastic, ModelInput, Sym6};
+use crate::model::{double_dot, ConstitutiveModel, LinearElastic, Sym6};
 use crate::MechError;
+
+mod element;
 
 const CHUNK: usize = 256;
 
@@ -436,237 +438,11 @@ fn geometry<D: Dim>(mesh: &Mesh<D>) -> ElementGeometry {
 }
 
 /// Inputs shared by all elements of one force evaluation.
-struct StepInputs<'a> {
-    conn: &'a [u32],
-    u: &'a [f64],
-    v: &'a [f64],
-    damping: bool,
-}
-
-impl Mechanics {
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn element_2d<U: FnOnce(&ModelInput<'_>, &mut Sym6, &mut [f64])>(
-        &self,
-        e: usize,
-        inp: &StepInputs<'_>,
-        slots: &mut [f64],
-        stress: &mut [f64],
-        strain: &mut [f64],
-        szz: &mut f64,
-        state: &mut [f64],
-        coupling: &[f64],
-        visc: Option<f64>,
-        theta: Option<f64>,
-        update: U,
-    ) {
-        let c = &inp.conn[3 * e..3 * e + 3];
-        let (n0, n1, n2) = (c[0] as usize * 2, c[1] as usize * 2, c[2] as usize * 2);
-        let m = &self.geo.dm_inv[4 * e..4 * e + 4];
-        // Displacement gradient H = ∂u/∂X = [u₁ − u₀, u₂ − u₀] D_m⁻¹ and F = I + H: built
-        // from displacement differences, not from current positions, so that small
-        // strains keep their digits (x = X + u would round u to the ulp of X).
-        // One bounds check per node.
-        let node = |x: &[f64], n: usize| -> [f64; 2] { [x[n], x[n + 1]] };
-        let (u0, u1, u2) = (node(inp.u, n0), node(inp.u, n1), node(inp.u, n2));
-        let (d0, d1, d2, d3) = (u1[0] - u0[0], u2[0] - u0[0], u1[1] - u0[1], u2[1] - u0[1]);
-        let h = [
-            d0 * m[0] + d1 * m[2],
-            d0 * m[1] + d1 * m[3],
-            d2 * m[0] + d3 * m[2],
-            d2 * m[1] + d3 * m[3],
-        ];
-        let (co, si, cm1) = polar_2d_h(&h);
-        // ε = U − I with U = Rᵀ(I + H), written without the cancellation of U − I:
-        // U₀₀ − 1 = (cos θ − 1) + cos θ H₀₀ + sin θ H₁₀, U₁₁ − 1 = (cos θ − 1) + cos θ H₁₁ − sin θ H₀₁,
-        // U₀₁ + U₁₀ = cos θ (H₀₁ + H₁₀) + sin θ (H₁₁ − H₀₀).
-        let mut eps: Sym6 = [
-            cm1 + co * h[0] + si * h[2],
-            cm1 + co * h[3] - si * h[1],
-            0.0,
-            0.5 * (co * (h[1] + h[2]) + si * (h[3] - h[0])),
-            0.0,
-            0.0,
-        ];
-        // Mixed cell: the cell's mean volumetric strain replaces the element's.
-        if let Some(mean) = theta {
-            let corr = 0.5 * (mean - trace_2d(&h));
-            eps[0] += corr;
-            eps[1] += corr;
-        }
-        let de: Sym6 = [
-            eps[0] - strain[0],
-            eps[1] - strain[1],
-            0.0,
-            eps[3] - strain[2],
-            0.0,
-            0.0,
-        ];
-        strain.copy_from_slice(&[eps[0], eps[1], eps[3]]);
-        let mut sig: Sym6 = [stress[0], stress[1], *szz, stress[2], 0.0, 0.0];
-        let input = ModelInput {
-            strain: &eps,
-            dstrain: &de,
-            coupling,
-        };
-        update(&input, &mut sig, state);
-        stress.copy_from_slice(&[sig[0], sig[1], sig[3]]);
-        *szz = sig[2];
-        let (mut sxx, mut syy, mut sxy) = (sig[0], sig[1], sig[3]);
-        if let Some(cv) = visc {
-            let (v0, v1, v2) = (node(inp.v, n0), node(inp.v, n1), node(inp.v, n2));
-            let dv = [v1[0] - v0[0], v2[0] - v0[0], v1[1] - v0[1], v2[1] - v0[1]];
-            let fd = [
-                dv[0] * m[0] + dv[1] * m[2],
-                dv[0] * m[1] + dv[1] * m[3],
-                dv[2] * m[0] + dv[3] * m[2],
-                dv[2] * m[1] + dv[3] * m[3],
-            ];
-            let r00 = co * fd[0] + si * fd[2];
-            let r01 = co * fd[1] + si * fd[3];
-            let r10 = -si * fd[0] + co * fd[2];
-            let r11 = -si * fd[1] + co * fd[3];
-            // eq. 17-19: σ_v = D_f C ε̇ with C = 2 L √(ρE)
-            sxx += cv * r00;
-            syy += cv * r11;
-            sxy += cv * 0.5 * (r01 + r10);
-        }
-        // P = R σ
-        let p00 = co * sxx - si * sxy;
-        let p01 = co * sxy - si * syy;
-        let p10 = si * sxx + co * sxy;
-        let p11 = si * sxy + co * syy;
-        let vol = self.geo.volume[e];
-        let g1 = [m[0], m[1]];
-        let g2 = [m[2], m[3]];
-        let f1 = [
-            -vol * (p00 * g1[0] + p01 * g1[1]),
-            -vol * (p10 * g1[0] + p11 * g1[1]),
-        ];
-        let f2 = [
-            -vol * (p00 * g2[0] + p01 * g2[1]),
-            -vol * (p10 * g2[0] + p11 * g2[1]),
-        ];
-        slots.copy_from_slice(&[
-            -(f1[0] + f2[0]),
-            -(f1[1] + f2[1]),
-            f1[0],
-            f1[1],
-            f2[0],
-            f2[1],
-        ]);
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn element_3d<U: FnOnce(&ModelInput<'_>, &mut Sym6, &mut [f64])>(
-        &self,
-        e: usize,
-        inp: &StepInputs<'_>,
-        slots: &mut [f64],
-        stress: &mut [f64],
-        strain: &mut [f64],
-        rot: &mut [f64],
-        state: &mut [f64],
-        coupling: &[f64],
-        visc: Option<f64>,
-        theta: Option<f64>,
-        update: U,
-    ) {
-        let c = &inp.conn[4 * e..4 * e + 4];
-        let n: [usize; 4] = [
-            c[0] as usize * 3,
-            c[1] as usize * 3,
-            c[2] as usize * 3,
-            c[3] as usize * 3,
-        ];
-        let m: &[f64] = &self.geo.dm_inv[9 * e..9 * e + 9];
-        // F = I + H with H = [u_j − u₀] D_m⁻¹ from displacement differences (see 2D).
-        let mut du = [0.0; 9];
-        for i in 0..3 {
-            let o = inp.u[n[0] + i];
-            for j in 0..3 {
-                du[3 * i + j] = inp.u[n[j + 1] + i] - o;
-            }
-        }
-        let mm: [f64; 9] = m.try_into().expect("9 values");
-        let mut f = crate::kinematics::mul3(&du, &mm);
-        f[0] += 1.0;
-        f[4] += 1.0;
-        f[8] += 1.0;
-        let r_prev: [f64; 9] = (&*rot).try_into().expect("9 values");
-        // A mixed cell's elements found their rotation in the trace pass of this step.
-        let r = if theta.is_some() {
-            r_prev
-        } else {
-            polar_3d(&f, &r_prev)
-        };
-        rot.copy_from_slice(&r);
-        let u = crate::kinematics::mul3_tn(&r, &f);
-        let mut eps: Sym6 = [
-            u[0] - 1.0,
-            u[4] - 1.0,
-            u[8] - 1.0,
-            0.5 * (u[1] + u[3]),
-            0.5 * (u[5] + u[7]),
-            0.5 * (u[2] + u[6]),
-        ];
-        if let Some(mean) = theta {
-            let corr = (mean - (eps[0] + eps[1] + eps[2])) / 3.0;
-            eps[0] += corr;
-            eps[1] += corr;
-            eps[2] += corr;
-        }
-        let mut de = [0.0; 6];
-        for k in 0..6 {
-            de[k] = eps[k] - strain[k];
-        }
-        strain.copy_from_slice(&eps);
-        let mut sig: Sym6 = [
-            stress[0], stress[1], stress[2], stress[3], stress[4], stress[5],
-        ];
-        let input = ModelInput {
-            strain: &eps,
-            dstrain: &de,
-            coupling,
-        };
-        update(&input, &mut sig, state);
-        stress.copy_from_slice(&sig);
-        if let Some(cv) = visc {
-            let mut dv = [0.0; 9];
-            for i in 0..3 {
-                let o = inp.v[n[0] + i];
-                for j in 0..3 {
-                    dv[3 * i + j] = inp.v[n[j + 1] + i] - o;
-                }
-            }
-            let fd = crate::kinematics::mul3(&dv, &mm);
-            let rd = crate::kinematics::mul3_tn(&r, &fd);
-            sig[0] += cv * rd[0];
-            sig[1] += cv * rd[4];
-            sig[2] += cv * rd[8];
-            sig[3] += cv * 0.5 * (rd[1] + rd[3]);
-            sig[4] += cv * 0.5 * (rd[5] + rd[7]);
-            sig[5] += cv * 0.5 * (rd[2] + rd[6]);
-        }
-        let s = [
-            sig[0], sig[3], sig[5], sig[3], sig[1], sig[4], sig[5], sig[4], sig[2],
-        ];
-        let pk = crate::kinematics::mul3(&r, &s);
-        let vol = self.geo.volume[e];
-        let mut f0 = [0.0; 3];
-        for a in 0..3 {
-            for i in 0..3 {
-                let fa = -vol
-                    * (pk[3 * i] * mm[3 * a]
-                        + pk[3 * i + 1] * mm[3 * a + 1]
-                        + pk[3 * i + 2] * mm[3 * a + 2]);
-                slots[3 * (a + 1) + i] = fa;
-                f0[i] -= fa;
-            }
-        }
-        slots[..3].copy_from_slice(&f0);
-    }
+pub(crate) struct StepInputs<'a> {
+    pub(crate) conn: &'a [u32],
+    pub(crate) u: &'a [f64],
+    pub(crate) v: &'a [f64],
+    pub(crate) damping: bool,
 }
 
 impl Mechanics {
@@ -1049,6 +825,8 @@ impl<D: Dim> Physics<D> for Mechanics {
         }
         let trace = &self.trace;
         let slots = &mut *ctx.slots;
+        // Only the built-in elastic law: one element at a time, halves back to back.
+        let all_inline = self.consts.iter().all(|k| k.elastic.is_some());
         ctx.backend.install(|| {
             slots
                 .par_chunks_mut(CHUNK * npe * d)
@@ -1059,63 +837,18 @@ impl<D: Dim> Physics<D> for Mechanics {
                 .enumerate()
                 .for_each(|(chunk, ((((sl, st), ep), ex), ms))| {
                     let first = chunk * CHUNK;
-                    // Each element's outputs as exact chunks: no bounds check per value.
-                    let per_element = sl
-                        .chunks_exact_mut(npe * d)
-                        .zip(st.chunks_exact_mut(nsym))
-                        .zip(ep.chunks_exact_mut(nsym))
-                        .zip(ex.chunks_exact_mut(nx))
-                        .zip(ms.chunks_exact_mut(ns));
-                    for (i, ((((sl, st), ep), ex), ms)) in per_element.enumerate() {
-                        let e = first + i;
-                        // A null element carries no force (manual 7.2.8).
-                        if null[e] != 0.0 {
-                            sl.fill(0.0);
-                            continue;
-                        }
-                        let cv: &[f64] = if cstride == 0 {
-                            &[]
-                        } else {
-                            let n = self.coupling.len_of_model[self.material[e] as usize];
-                            &cref[e * cstride..e * cstride + n]
+                    if all_inline {
+                        self.elastic_chunk::<D>(first, &inp, sl, st, ep, ex, null, trace);
+                    } else {
+                        let cv = |e: usize| -> &[f64] {
+                            if cstride == 0 {
+                                &[]
+                            } else {
+                                let n = self.coupling.len_of_model[self.material[e] as usize];
+                                &cref[e * cstride..e * cstride + n]
+                            }
                         };
-                        let mi = self.material[e] as usize;
-                        let k = self.consts[mi];
-                        let visc =
-                            (inp.damping && k.damp2 > 0.0).then(|| self.viscous_coefficient(e));
-                        let model = &*self.models[mi];
-                        let theta = self
-                            .mixed
-                            .as_ref()
-                            .filter(|mx| mx.is_mixed(e))
-                            .map(|mx| mx.mean(e, trace));
-                        // The built-in elastic law inline, any other through its trait.
-                        macro_rules! element {
-                            ($update:expr) => {
-                                if d == 2 {
-                                    self.element_2d(
-                                        e, &inp, sl, st, ep, &mut ex[0], ms, cv, visc, theta,
-                                        $update,
-                                    );
-                                } else {
-                                    self.element_3d(
-                                        e, &inp, sl, st, ep, ex, ms, cv, visc, theta, $update,
-                                    );
-                                }
-                            };
-                        }
-                        match k.elastic {
-                            Some((l, m2)) => {
-                                element!(|x: &ModelInput<'_>, sig: &mut Sym6, _: &mut [f64]| {
-                                    add_hooke(l, m2, x.dstrain, sig)
-                                })
-                            }
-                            None => {
-                                element!(|x: &ModelInput<'_>, sig: &mut Sym6, st: &mut [f64]| {
-                                    model.update_with(x, sig, st)
-                                })
-                            }
-                        }
+                        self.model_chunk::<D>(first, &inp, sl, st, ep, ex, ms, null, trace, cv);
                     }
                 });
         });

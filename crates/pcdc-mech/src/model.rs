@@ -68,6 +68,30 @@ pub trait ConstitutiveModel: Send + Sync + std::fmt::Debug {
     fn update_with(&self, input: &ModelInput<'_>, stress: &mut Sym6, state: &mut [f64]) {
         self.update(input.strain, input.dstrain, stress, state)
     }
+    /// Updates a run of consecutive elements of this model at once: element i has inputs
+    /// `inputs[i]`, stress `stresses[i]` (in: σ(t), out: σ(t+Δt), Pa) and history
+    /// `states[i * stride..][..stride]` (`stride` ≥ [`Self::n_state`]; the first
+    /// [`Self::n_state`] values are the model's). The mechanics calls this method on the
+    /// CPU (up to 16 elements at a time), never [`Self::update_with`] directly. The
+    /// default calls [`Self::update_with`] for each element in turn; a model overrides it
+    /// to work on several elements side by side (e.g. [`crate::MohrCoulomb`] decomposes
+    /// its stresses in lanes). An override must give each element what
+    /// [`Self::update_with`] gives it.
+    fn update_many(
+        &self,
+        inputs: &[ModelInput<'_>],
+        stresses: &mut [Sym6],
+        states: &mut [f64],
+        stride: usize,
+    ) {
+        for ((input, stress), state) in inputs
+            .iter()
+            .zip(stresses.iter_mut())
+            .zip(states.chunks_mut(stride.max(1)))
+        {
+            self.update_with(input, stress, state);
+        }
+    }
     /// The constant tangent `dσ/dε` as a 6x6 matrix acting on tensor strain components
     /// (`σ_xy = T[3][3] ε_xy`, ...), if the model is linear; enables the direct static solve.
     fn linear_tangent(&self) -> Option<[[f64; 6]; 6]> {

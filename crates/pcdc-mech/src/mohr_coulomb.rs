@@ -57,8 +57,11 @@ use serde::{Deserialize, Serialize};
 
 use pcdc_compute::Table;
 
-use crate::model::{add_hooke, ConstitutiveModel, LinearElastic, Sym6, WgslModel};
-use crate::principal::{compose, compose_plane, plane, principal, JACOBI_STOP};
+use crate::model::{add_hooke, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};
+use crate::principal::{
+    compose, compose_plane, plane, principal, principal_lanes, PlanePrincipal, Principal,
+    JACOBI_STOP, LANES,
+};
 use crate::MechError;
 
 /// Number of history variables of [`MohrCoulomb`].
@@ -687,6 +690,63 @@ fn solve_small<const N: usize>(a: &[[f64; 3]; 3], b: &[f64; 3]) -> Option<[f64; 
     Some(x)
 }
 
+/// True when a tensor is plane (yz = xz = 0): plane strain, whose principal stresses
+/// come in closed form.
+fn is_plane(t: &Sym6) -> bool {
+    t[4] == 0.0 && t[5] == 0.0
+}
+
+impl MohrCoulomb {
+    /// The elastic trial σ + D Δε in `stress` and the step's flags cleared; false when
+    /// the trial is surely elastic ([`Surfaces::surely_elastic`] with the surfaces of
+    /// the element's plastic strains): then `stress` is the new stress.
+    #[inline(always)]
+    fn trial(&self, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) -> bool {
+        add_hooke(self.lame.0, self.lame.1, de, stress);
+        st[state::SHEAR_NOW] = 0.0;
+        st[state::TENSION_NOW] = 0.0;
+        let surfaces = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
+        !surfaces.surely_elastic(stress)
+    }
+
+    /// Returns a plane trial stress to the surfaces (closed-form principal stresses).
+    fn plastic_plane(&self, surfaces: &Surfaces, stress: &mut Sym6, st: &mut [f64]) {
+        let p = plane(stress);
+        if let Some(r) = surfaces.return_map(&p.values) {
+            *stress = compose_plane(&r.stress, &p);
+            record(&r, st);
+        }
+    }
+
+    /// Returns a trial stress with principal decomposition `p` to the surfaces.
+    fn plastic(&self, surfaces: &Surfaces, p: &Principal, stress: &mut Sym6, st: &mut [f64]) {
+        if let Some(r) = surfaces.return_map(&p.values) {
+            *stress = compose(&r.stress, &p.axes);
+            record(&r, st);
+        }
+    }
+}
+
+/// Writes what a return did to the element's history: the flags, and the plastic shear
+/// and tensile strains.
+fn record(r: &Return, st: &mut [f64]) {
+    if r.shear > 0.0 {
+        st[state::SHEAR_NOW] = 1.0;
+        st[state::SHEAR_PAST] = 1.0;
+        // FLAC's shear hardening parameter from the shear planes' plastic strain, in its
+        // symmetric form (all three components: on an edge the middle one is not zero).
+        let ep = r.shear_strain;
+        let m = (ep[0] + ep[1] + ep[2]) * (1.0 / 3.0);
+        let (a, b, c) = (ep[0] - m, ep[1] - m, ep[2] - m);
+        st[state::SHEAR_STRAIN] += (0.5 * (a * a + b * b + c * c)).sqrt();
+    }
+    if r.tension > 0.0 {
+        st[state::TENSION_NOW] = 1.0;
+        st[state::TENSION_PAST] = 1.0;
+        st[state::TENSION_STRAIN] += r.tension;
+    }
+}
+
 impl ConstitutiveModel for MohrCoulomb {
     fn name(&self) -> &str {
         "mech-mohr-coulomb"
@@ -696,44 +756,83 @@ impl ConstitutiveModel for MohrCoulomb {
         MC_STATE
     }
     fn update(&self, _strain: &Sym6, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) {
-        add_hooke(self.lame.0, self.lame.1, de, stress);
-        st[state::SHEAR_NOW] = 0.0;
-        st[state::TENSION_NOW] = 0.0;
-        let surfaces = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
-        if surfaces.surely_elastic(stress) {
+        if !self.trial(de, stress, st) {
             return;
         }
+        let surfaces = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
         // Plane strain in closed form, else Jacobi (the same values to rounding).
-        let r = if stress[4] == 0.0 && stress[5] == 0.0 {
-            let p = plane(stress);
-            let Some(r) = surfaces.return_map(&p.values) else {
-                return;
-            };
-            *stress = compose_plane(&r.stress, &p);
-            r
+        if is_plane(stress) {
+            self.plastic_plane(&surfaces, stress, st);
         } else {
             let p = principal(stress);
-            let Some(r) = surfaces.return_map(&p.values) else {
-                return;
-            };
-            *stress = compose(&r.stress, &p.axes);
-            r
-        };
-        if r.shear > 0.0 {
-            st[state::SHEAR_NOW] = 1.0;
-            st[state::SHEAR_PAST] = 1.0;
-            // FLAC's shear hardening parameter from the shear planes' plastic strain, in
-            // its symmetric form (all three components: on an edge the middle one is not
-            // zero).
-            let ep = r.shear_strain;
-            let m = (ep[0] + ep[1] + ep[2]) * (1.0 / 3.0);
-            let (a, b, c) = (ep[0] - m, ep[1] - m, ep[2] - m);
-            st[state::SHEAR_STRAIN] += (0.5 * (a * a + b * b + c * c)).sqrt();
+            self.plastic(&surfaces, &p, stress, st);
         }
-        if r.tension > 0.0 {
-            st[state::TENSION_NOW] = 1.0;
-            st[state::TENSION_PAST] = 1.0;
-            st[state::TENSION_STRAIN] += r.tension;
+    }
+    /// As [`MohrCoulomb::update`] for each element, bit for bit, with the 3D principal
+    /// decompositions of the elements that need one done [`LANES`] at a time
+    /// ([`principal_lanes`]): one Jacobi decomposition is a chain of dependent roots and
+    /// divisions, and several side by side cost little more than one.
+    fn update_many(
+        &self,
+        inputs: &[ModelInput<'_>],
+        stresses: &mut [Sym6],
+        states: &mut [f64],
+        stride: usize,
+    ) {
+        const BLOCK: usize = 2 * LANES;
+        let stride = stride.max(1);
+        let blocks = inputs
+            .chunks(BLOCK)
+            .zip(stresses.chunks_mut(BLOCK))
+            .zip(states.chunks_mut(BLOCK * stride));
+        for ((inputs, stresses), states) in blocks {
+            // The elastic trial of each; plane ones return at once, 3D ones wait for their
+            // axes.
+            // The elastic trials first; those that may yield wait for their principal
+            // stresses, plane ones (closed form) and 3D ones (Jacobi) apart.
+            let (mut plane_wait, mut wait) = ([0usize; BLOCK], [0usize; BLOCK]);
+            let (mut np, mut n) = (0, 0);
+            for (i, (x, s)) in inputs.iter().zip(stresses.iter_mut()).enumerate() {
+                let st = &mut states[i * stride..(i + 1) * stride];
+                if !self.trial(x.dstrain, s, st) {
+                    continue;
+                }
+                if is_plane(s) {
+                    plane_wait[np] = i;
+                    np += 1;
+                } else {
+                    wait[n] = i;
+                    n += 1;
+                }
+            }
+            // The surfaces of the element's plastic strains (unchanged since the trial).
+            let surfaces =
+                |st: &[f64]| self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
+            let planes: [PlanePrincipal; BLOCK] =
+                std::array::from_fn(|k| plane(&stresses[plane_wait[k.min(np.saturating_sub(1))]]));
+            for (&i, p) in plane_wait[..np].iter().zip(&planes) {
+                let st = &mut states[i * stride..];
+                if let Some(r) = surfaces(st).return_map(&p.values) {
+                    stresses[i] = compose_plane(&r.stress, p);
+                    record(&r, st);
+                }
+            }
+            for group in wait[..n].chunks(LANES) {
+                if group.len() <= 2 {
+                    for &i in group {
+                        let (p, st) = (principal(&stresses[i]), &mut states[i * stride..]);
+                        self.plastic(&surfaces(st), &p, &mut stresses[i], st);
+                    }
+                    continue;
+                }
+                // Unused lanes get a zero tensor, which needs no rotation.
+                let ts = std::array::from_fn(|l| group.get(l).map_or([0.0; 6], |&i| stresses[i]));
+                let ps = principal_lanes(&ts);
+                for (&i, p) in group.iter().zip(&ps) {
+                    let st = &mut states[i * stride..];
+                    self.plastic(&surfaces(st), p, &mut stresses[i], st);
+                }
+            }
         }
     }
     fn wgsl(&self) -> Option<WgslModel> {

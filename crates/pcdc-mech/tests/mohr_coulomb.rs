@@ -2,7 +2,7 @@
 
 use pcdc_mech::mohr_coulomb::{state, Surfaces, MC_STATE};
 use pcdc_mech::principal::principal;
-use pcdc_mech::{ConstitutiveModel, LinearElastic, MohrCoulomb, Softening, Sym6};
+use pcdc_mech::{ConstitutiveModel, LinearElastic, ModelInput, MohrCoulomb, Softening, Sym6};
 use proptest::prelude::*;
 
 fn model(c: f64, phi: f64, psi: f64, st: f64) -> MohrCoulomb {
@@ -442,4 +442,50 @@ fn vtu_step_shows_the_plastic_state() {
     let yielded = shear_past.iter().filter(|&&v| v == 1.0).count();
     assert!(yielded > 0 && yielded < ne, "{yielded} of {ne} yielded");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+proptest! {
+    /// The run update (3D decompositions in lanes, plane ones apart) gives every element
+    /// what the one-element update gives it, bit for bit: runs of any length, plane and
+    /// 3D, elastic and yielding elements mixed, with softening (surfaces per element)
+    /// and without, and a state stride wider than the model's.
+    #[test]
+    fn update_many_is_the_one_element_update_bit_for_bit(
+        soft in any::<bool>(),
+        elements in prop::collection::vec(
+            (tensor(20e6), tensor(2e-3), any::<bool>(), 0.0..2e-3f64),
+            1..40,
+        ),
+    ) {
+        let m = if soft { softening_model() } else { model(4e6, 35.0, 10.0, 2e6) };
+        let stride = MC_STATE + 2;
+        let n = elements.len();
+        let (mut s1, mut s2) = (Vec::new(), Vec::new());
+        let (mut st1, mut st2) = (vec![0.0; n * stride], vec![0.0; n * stride]);
+        let mut des = Vec::new();
+        for (i, (sig, de, plane, kappa)) in elements.iter().enumerate() {
+            let (mut sig, mut de) = (*sig, *de);
+            if *plane {
+                (sig[4], sig[5], de[2], de[4], de[5]) = (0.0, 0.0, 0.0, 0.0, 0.0);
+            }
+            s1.push(sig);
+            s2.push(sig);
+            des.push(de);
+            st1[i * stride + state::SHEAR_STRAIN] = *kappa;
+            st1[i * stride + stride - 1] = 7.0; // beyond the model's values: untouched
+        }
+        st2.clone_from(&st1);
+        for i in 0..n {
+            m.update(&des[i], &des[i], &mut s1[i], &mut st1[i * stride..(i + 1) * stride]);
+        }
+        let inputs: Vec<_> = des.iter().map(|d| ModelInput::new(d, d, &[])).collect();
+        m.update_many(&inputs, &mut s2, &mut st2, stride);
+        for i in 0..n {
+            prop_assert_eq!(s1[i].map(f64::to_bits), s2[i].map(f64::to_bits), "element {}", i);
+        }
+        prop_assert_eq!(
+            st1.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            st2.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        );
+    }
 }
