@@ -22,7 +22,7 @@
 //! | --- | --- | --- |
 //! | 7.1 i–v | explicit central differences `v += dt F/m`, `u += dt v` | `pcdc_compute::Simulation` |
 //! | eq. 1–11 | constant element strain; here its large-rotation form: `F = D_s D_m⁻¹`, `F = R U`, `ε = U − I` | [`kinematics`] |
-//! | eq. 12 | `σ(t+Δt) = H(σ(t), ε, Δε, history)` (and coupling inputs) | [`ConstitutiveModel::update`], [`ConstitutiveModel::update_with`] |
+//! | eq. 12 | `σ(t+Δt) = H(σ(t), ε, Δε, history)` (and coupling inputs) | [`ConstitutiveModel::update`], [`ConstitutiveModel::update_with`], [`ConstitutiveModel::update_many`] (a run of elements at once on the CPU) |
 //! | eq. 13–14 | nodal forces from the element stress, `f_a = −V₀ R σ ∇N_a` | `Mechanics` |
 //! | eq. 15–16 | body force and lumped mass `ρV/(N+1)` per node | `Mechanics`, gravity in `Simulation` |
 //! | eq. 17–19 | viscous stress `σ_v = D_f C ε̇`, `C = 2L√(ρE)`, L = mean edge length | `Mechanics` |
