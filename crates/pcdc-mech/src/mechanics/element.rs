@@ -350,25 +350,43 @@ impl Mechanics {
                 sl.fill(0.0);
                 continue;
             }
-            let (l, m2) = self.consts[self.material[e] as usize]
+            let lame = self.consts[self.material[e] as usize]
                 .elastic
                 .expect("elastic_chunk runs only when every material is the inline law");
-            let (visc, theta) = (self.visc(e, inp), self.theta(e, trace));
-            if d == 2 {
-                let mut t = self.trial_2d(e, inp, st, ep, ex[0], theta);
-                add_hooke(l, m2, &t.de, &mut t.sig);
-                self.forces_2d(e, inp, sl, st, &mut ex[0], &t.sig, &t.rot, visc);
-            } else {
-                let mut t = self.trial_3d(e, inp, st, ep, ex, theta);
-                add_hooke(l, m2, &t.de, &mut t.sig);
-                self.forces_3d(e, inp, sl, st, &t.sig, &t.rot, visc);
-            }
+            self.elastic_element::<D>(e, inp, sl, st, ep, ex, trace, lame);
+        }
+    }
+
+    /// One element with the inline elastic law (Lamé λ, 2μ in `lame`), halves back to
+    /// back; the slices are the element's own.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn elastic_element<D: Dim>(
+        &self,
+        e: usize,
+        inp: &StepInputs<'_>,
+        sl: &mut [f64],
+        st: &mut [f64],
+        ep: &mut [f64],
+        ex: &mut [f64],
+        trace: &[f64],
+        (l, m2): (f64, f64),
+    ) {
+        let (visc, theta) = (self.visc(e, inp), self.theta(e, trace));
+        if D::D == 2 {
+            let mut t = self.trial_2d(e, inp, st, ep, ex[0], theta);
+            add_hooke(l, m2, &t.de, &mut t.sig);
+            self.forces_2d(e, inp, sl, st, &mut ex[0], &t.sig, &t.rot, visc);
+        } else {
+            let mut t = self.trial_3d(e, inp, st, ep, ex, theta);
+            add_hooke(l, m2, &t.de, &mut t.sig);
+            self.forces_3d(e, inp, sl, st, &t.sig, &t.rot, visc);
         }
     }
 
     /// The elements of one chunk with any materials: the inline elastic law one element
     /// at a time, any other model a run of up to [`BATCH`] consecutive live elements of
-    /// the same material at once (trial halves, [`crate::ConstitutiveModel::update_many`],
+    /// its material at once (trial halves, [`crate::ConstitutiveModel::update_many`],
     /// force halves). `coupling(e)` gives element e's coupling values.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn model_chunk<'c, D: Dim>(
@@ -387,6 +405,9 @@ impl Mechanics {
         let (d, npe, nsym) = (D::D, D::NODES_PER_ELEM, D::NSYM);
         let (nf, nx) = (npe * d, if d == 2 { 1 } else { 9 });
         let (ns, len) = (self.n_state.max(1), st.len() / nsym);
+        // Buffers for the chunk's runs, set once per chunk, not per run.
+        let mut trials = [Trial::default(); BATCH];
+        let mut sigs = [[0.0; 6]; BATCH];
         let mut i = 0;
         while i < len {
             let e = first + i;
@@ -396,19 +417,31 @@ impl Mechanics {
                 continue;
             }
             let mi = self.material[e] as usize;
+            // The inline elastic law: this element alone, halves back to back.
+            if let Some(lame) = self.consts[mi].elastic {
+                self.elastic_element::<D>(
+                    e,
+                    inp,
+                    &mut sl[i * nf..(i + 1) * nf],
+                    &mut st[i * nsym..(i + 1) * nsym],
+                    &mut ep[i * nsym..(i + 1) * nsym],
+                    &mut ex[i * nx..(i + 1) * nx],
+                    trace,
+                    lame,
+                );
+                i += 1;
+                continue;
+            }
             // The run of live elements of this material that the model gets at once.
             let mut j = i + 1;
-            if self.consts[mi].elastic.is_none() {
-                while j < len
-                    && j - i < BATCH
-                    && null[first + j] == 0.0
-                    && self.material[first + j] as usize == mi
-                {
-                    j += 1;
-                }
+            while j < len
+                && j - i < BATCH
+                && null[first + j] == 0.0
+                && self.material[first + j] as usize == mi
+            {
+                j += 1;
             }
             let n = j - i;
-            let mut trials = [Trial::default(); BATCH];
             for (b, t) in trials[..n].iter_mut().enumerate() {
                 let (e, a) = (first + i + b, i + b);
                 let theta = self.theta(e, trace);
@@ -421,23 +454,13 @@ impl Mechanics {
                 } else {
                     self.trial_3d(e, inp, s, p, &mut ex[a * nx..(a + 1) * nx], theta)
                 };
+                sigs[b] = t.sig;
             }
-            let mut sigs: [Sym6; BATCH] = std::array::from_fn(|b| trials[b].sig);
-            match self.consts[mi].elastic {
-                Some((l, m2)) => add_hooke(l, m2, &trials[0].de, &mut sigs[0]),
-                None => {
-                    let inputs: [ModelInput<'_>; BATCH] = std::array::from_fn(|b| {
-                        let t = &trials[b.min(n - 1)];
-                        ModelInput::new(&t.eps, &t.de, coupling(first + i + b.min(n - 1)))
-                    });
-                    self.models[mi].update_many(
-                        &inputs[..n],
-                        &mut sigs[..n],
-                        &mut ms[i * ns..j * ns],
-                        ns,
-                    );
-                }
-            }
+            let inputs: [ModelInput<'_>; BATCH] = std::array::from_fn(|b| {
+                let t = &trials[b.min(n - 1)];
+                ModelInput::new(&t.eps, &t.de, coupling(first + i + b.min(n - 1)))
+            });
+            self.models[mi].update_many(&inputs[..n], &mut sigs[..n], &mut ms[i * ns..j * ns], ns);
             for b in 0..n {
                 let (e, a) = (first + i + b, i + b);
                 let (f, s) = (
