@@ -59,8 +59,7 @@ use pcdc_compute::Table;
 
 use crate::model::{add_hooke, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};
 use crate::principal::{
-    compose, compose_plane, plane, principal, principal_lanes, PlanePrincipal, Principal,
-    JACOBI_STOP, LANES,
+    compose, compose_plane, plane, principal, principal_lanes, Principal, JACOBI_STOP, LANES,
 };
 use crate::MechError;
 
@@ -786,8 +785,6 @@ impl ConstitutiveModel for MohrCoulomb {
             .zip(stresses.chunks_mut(BLOCK))
             .zip(states.chunks_mut(BLOCK * stride));
         for ((inputs, stresses), states) in blocks {
-            // The elastic trial of each; plane ones return at once, 3D ones wait for their
-            // axes.
             // The elastic trials first; those that may yield wait for their principal
             // stresses, plane ones (closed form) and 3D ones (Jacobi) apart.
             let (mut plane_wait, mut wait) = ([0usize; BLOCK], [0usize; BLOCK]);
@@ -808,14 +805,9 @@ impl ConstitutiveModel for MohrCoulomb {
             // The surfaces of the element's plastic strains (unchanged since the trial).
             let surfaces =
                 |st: &[f64]| self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
-            let planes: [PlanePrincipal; BLOCK] =
-                std::array::from_fn(|k| plane(&stresses[plane_wait[k.min(np.saturating_sub(1))]]));
-            for (&i, p) in plane_wait[..np].iter().zip(&planes) {
+            for &i in &plane_wait[..np] {
                 let st = &mut states[i * stride..];
-                if let Some(r) = surfaces(st).return_map(&p.values) {
-                    stresses[i] = compose_plane(&r.stress, p);
-                    record(&r, st);
-                }
+                self.plastic_plane(&surfaces(st), &mut stresses[i], st);
             }
             for group in wait[..n].chunks(LANES) {
                 if group.len() <= 2 {

@@ -55,9 +55,14 @@ pub fn principal(t: &Sym6) -> Principal {
             rotate(&mut a, &mut v, p, q);
         }
     }
-    // Sort ascending, carrying the axes (columns of v).
+    ascending([a[0][0], a[1][1], a[2][2]], |k| [v[0][k], v[1][k], v[2][k]])
+}
+
+/// The diagonal `d` of a rotated tensor sorted ascending, each value with its axis
+/// (`axis(k)`: column k of the accumulated rotation).
+#[inline(always)]
+fn ascending(d: [f64; 3], axis: impl Fn(usize) -> [f64; 3]) -> Principal {
     let mut idx = [0usize, 1, 2];
-    let d = [a[0][0], a[1][1], a[2][2]];
     if d[idx[1]] < d[idx[0]] {
         idx.swap(0, 1);
     }
@@ -67,7 +72,6 @@ pub fn principal(t: &Sym6) -> Principal {
     if d[idx[1]] < d[idx[0]] {
         idx.swap(0, 1);
     }
-    let axis = |k: usize| [v[0][k], v[1][k], v[2][k]];
     Principal {
         values: [d[idx[0]], d[idx[1]], d[idx[2]]],
         axes: [axis(idx[0]), axis(idx[1]), axis(idx[2])],
@@ -122,22 +126,9 @@ pub fn principal_lanes(ts: &[Sym6; LANES]) -> [Principal; LANES] {
         }
     }
     std::array::from_fn(|l| {
-        let d = [a[0][0][l], a[1][1][l], a[2][2][l]];
-        let mut idx = [0usize, 1, 2];
-        if d[idx[1]] < d[idx[0]] {
-            idx.swap(0, 1);
-        }
-        if d[idx[2]] < d[idx[1]] {
-            idx.swap(1, 2);
-        }
-        if d[idx[1]] < d[idx[0]] {
-            idx.swap(0, 1);
-        }
-        let axis = |k: usize| [v[0][k][l], v[1][k][l], v[2][k][l]];
-        Principal {
-            values: [d[idx[0]], d[idx[1]], d[idx[2]]],
-            axes: [axis(idx[0]), axis(idx[1]), axis(idx[2])],
-        }
+        ascending([a[0][0][l], a[1][1][l], a[2][2][l]], |k| {
+            [v[0][k][l], v[1][k][l], v[2][k][l]]
+        })
     })
 }
 
