@@ -76,7 +76,8 @@ pub trait ConstitutiveModel: Send + Sync + std::fmt::Debug {
     /// default calls [`Self::update_with`] for each element in turn; a model overrides it
     /// to work on several elements side by side (e.g. [`crate::MohrCoulomb`] decomposes
     /// its stresses in lanes). An override must give each element what
-    /// [`Self::update_with`] gives it.
+    /// [`Self::update_with`] gives it. Slices of unequal length are not an error: the
+    /// elements beyond the shortest (`states` counted in strides) are left alone.
     fn update_many(
         &self,
         inputs: &[ModelInput<'_>],

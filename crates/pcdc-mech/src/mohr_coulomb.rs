@@ -780,6 +780,9 @@ impl ConstitutiveModel for MohrCoulomb {
     ) {
         const BLOCK: usize = 2 * LANES;
         let stride = stride.max(1);
+        // As the default: elements beyond the shortest of the three are left alone.
+        let n = inputs.len().min(stresses.len()).min(states.len() / stride);
+        let (inputs, stresses) = (&inputs[..n], &mut stresses[..n]);
         let blocks = inputs
             .chunks(BLOCK)
             .zip(stresses.chunks_mut(BLOCK))

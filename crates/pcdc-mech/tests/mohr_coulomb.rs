@@ -489,3 +489,17 @@ proptest! {
         );
     }
 }
+
+#[test]
+fn update_many_leaves_elements_beyond_the_shortest_slice_alone() {
+    // A caller's slices of unequal length: no panic, the extra elements untouched.
+    let m = model(1e6, 30.0, 5.0, 0.5e6);
+    let de = [-1e-3, 0.0, 0.0, 2e-4, 1e-4, 0.0];
+    let inputs = vec![ModelInput::new(&de, &de, &[]); 3];
+    let mut stresses = vec![[0.0; 6]; 3];
+    let mut states = vec![0.0; 2 * MC_STATE + 1];
+    m.update_many(&inputs, &mut stresses, &mut states, MC_STATE);
+    assert_ne!(stresses[1], [0.0; 6]);
+    assert_eq!(stresses[2], [0.0; 6]);
+    assert_eq!(states[2 * MC_STATE], 0.0);
+}
