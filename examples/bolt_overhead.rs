@@ -8,6 +8,9 @@
 //! ```sh
 //! cargo run --release --example bolt_overhead -- --threads 1,2 --per 50 --rounds 8
 //! ```
+//!
+//! `--only bolted` (or `alone`) times one variant, so that a profiler sees one of them:
+//! `perf record -F 10000 target/release/examples/bolt_overhead --threads 1 --only bolted`.
 
 use std::time::Instant;
 
@@ -54,11 +57,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .default_value("0.1")
                 .help("Element size at the wall (m)"),
         )
+        .arg(
+            Arg::new("only")
+                .long("only")
+                .value_parser(["alone", "bolted"])
+                .help("Time one variant only (e.g. under a profiler); no overhead is printed"),
+        )
         .get_matches();
     let per = *args.get_one::<u64>("per").expect("default") as usize;
     let rounds = *args.get_one::<u64>("rounds").expect("default");
     let steps = *args.get_one::<u64>("steps").expect("default");
     let size = *args.get_one::<f64>("size").expect("default");
+    let only = args.get_one::<String>("only").map(|s| s == "bolted");
     for &t in args.get_many::<usize>("threads").expect("default") {
         let backend = Backend::cpu(t)?;
         let ne = simulation(&backend, size, None)?.mesh().n_elements();
@@ -70,12 +80,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         for _ in 0..rounds {
             for (i, bolts) in [None, Some(n_bolts)].into_iter().enumerate() {
+                if only.is_some_and(|b| b != (i == 1)) {
+                    continue;
+                }
                 let pattern = bolts.map(bolt_pattern).transpose()?;
                 let mut sim = simulation(&backend, size, pattern)?;
                 let t0 = Instant::now();
                 sim.run(steps)?;
                 best[i] = best[i].min(t0.elapsed().as_secs_f64());
             }
+        }
+        if only.is_some() {
+            let i = usize::from(only == Some(true));
+            println!(
+                "threads {t}: {ne} elements, {} bolts: {:.2} ms per {steps} steps (best of {rounds})",
+                if i == 1 { n_bolts } else { 0 },
+                best[i] * 1e3
+            );
+            continue;
         }
         println!(
             "threads {t}: {ne} elements, {n_bolts} bolts: alone {:.2} ms, bolted {:.2} ms \
