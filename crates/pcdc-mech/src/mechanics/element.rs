@@ -16,15 +16,16 @@ use crate::model::{add_hooke, ModelInput, Sym6};
 /// Most elements handed to a model at once ([`crate::ConstitutiveModel::update_many`]).
 const BATCH: usize = 16;
 
-/// What the first half of an element's step leaves for the model and the second half.
+/// What the first half of an element's step leaves for the model and the second half,
+/// besides σ(t). Written in place: a triangle writes only the entries that can be
+/// non-zero (xx, yy, xy; cos θ, sin θ), so a buffer of them, zeroed once, is not
+/// zero-filled again per element.
 #[derive(Clone, Copy, Debug, Default)]
 struct Trial {
     /// Total co-rotated strain ε(t+Δt).
     eps: Sym6,
     /// Its increment over the step.
     de: Sym6,
-    /// σ(t), to become σ(t+Δt).
-    sig: Sym6,
     /// The element rotation: cos θ, sin θ in 2D; R (row-major) in 3D.
     rot: [f64; 9],
 }
@@ -38,17 +39,18 @@ fn node2(x: &[f64], n: usize) -> [f64; 2] {
 impl Mechanics {
     /// The first half of a triangle's step: H = [u₁ − u₀, u₂ − u₀] D_m⁻¹, its polar
     /// rotation, the co-rotated strain (written to `strain`: xx, yy, xy) and the trial
-    /// inputs; `szz` is σzz (plane strain), `theta` a mixed cell's mean volumetric strain.
+    /// inputs into `t` (its zz, yz, xz strains and 3D rotation entries left as they
+    /// are: zero); `szz` is σzz (plane strain), `theta` a mixed cell's mean volumetric
+    /// strain.
     #[inline(always)]
     fn trial_2d(
         &self,
         e: usize,
         inp: &StepInputs<'_>,
-        stress: &[f64],
         strain: &mut [f64],
-        szz: f64,
         theta: Option<f64>,
-    ) -> Trial {
+        t: &mut Trial,
+    ) {
         let c = &inp.conn[3 * e..3 * e + 3];
         let (n0, n1, n2) = (c[0] as usize * 2, c[1] as usize * 2, c[2] as usize * 2);
         let m = &self.geo.dm_inv[4 * e..4 * e + 4];
@@ -67,13 +69,10 @@ impl Mechanics {
         // ε = U − I with U = Rᵀ(I + H), written without the cancellation of U − I:
         // U₀₀ − 1 = (cos θ − 1) + cos θ H₀₀ + sin θ H₁₀, U₁₁ − 1 = (cos θ − 1) + cos θ H₁₁ − sin θ H₀₁,
         // U₀₁ + U₁₀ = cos θ (H₀₁ + H₁₀) + sin θ (H₁₁ − H₀₀).
-        let mut eps: Sym6 = [
+        let mut eps = [
             cm1 + co * h[0] + si * h[2],
             cm1 + co * h[3] - si * h[1],
-            0.0,
             0.5 * (co * (h[1] + h[2]) + si * (h[3] - h[0])),
-            0.0,
-            0.0,
         ];
         // Mixed cell: the cell's mean volumetric strain replaces the element's.
         if let Some(mean) = theta {
@@ -81,24 +80,11 @@ impl Mechanics {
             eps[0] += corr;
             eps[1] += corr;
         }
-        let de: Sym6 = [
-            eps[0] - strain[0],
-            eps[1] - strain[1],
-            0.0,
-            eps[3] - strain[2],
-            0.0,
-            0.0,
-        ];
-        strain.copy_from_slice(&[eps[0], eps[1], eps[3]]);
-        let mut rot = [0.0; 9];
-        rot[0] = co;
-        rot[1] = si;
-        Trial {
-            eps,
-            de,
-            sig: [stress[0], stress[1], szz, stress[2], 0.0, 0.0],
-            rot,
-        }
+        let de = [eps[0] - strain[0], eps[1] - strain[1], eps[2] - strain[2]];
+        strain.copy_from_slice(&eps);
+        (t.eps[0], t.eps[1], t.eps[3]) = (eps[0], eps[1], eps[2]);
+        (t.de[0], t.de[1], t.de[3]) = (de[0], de[1], de[2]);
+        (t.rot[0], t.rot[1]) = (co, si);
     }
 
     /// The second half of a triangle's step: stores σ(t+Δt) `sig` (xx, yy, xy in
@@ -177,11 +163,11 @@ impl Mechanics {
         &self,
         e: usize,
         inp: &StepInputs<'_>,
-        stress: &[f64],
         strain: &mut [f64],
         rot: &mut [f64],
         theta: Option<f64>,
-    ) -> Trial {
+        t: &mut Trial,
+    ) {
         let c = &inp.conn[4 * e..4 * e + 4];
         let n: [usize; 4] = [
             c[0] as usize * 3,
@@ -231,14 +217,7 @@ impl Mechanics {
             de[k] = eps[k] - strain[k];
         }
         strain.copy_from_slice(&eps);
-        Trial {
-            eps,
-            de,
-            sig: [
-                stress[0], stress[1], stress[2], stress[3], stress[4], stress[5],
-            ],
-            rot: r,
-        }
+        *t = Trial { eps, de, rot: r };
     }
 
     /// The second half of a tetrahedron's step: stores σ(t+Δt) `sig` in `stress`, adds
@@ -301,6 +280,17 @@ impl Mechanics {
             }
         }
         slots[..3].copy_from_slice(&f0);
+    }
+}
+
+/// σ(t) of an element as a tensor from its stress entries `s` (xx, yy, xy in 2D, with
+/// σzz the first of its extra entries `x`; six in 3D).
+#[inline(always)]
+fn sigma<D: Dim>(s: &[f64], x: &[f64]) -> Sym6 {
+    if D::D == 2 {
+        [s[0], s[1], x[0], s[2], 0.0, 0.0]
+    } else {
+        [s[0], s[1], s[2], s[3], s[4], s[5]]
     }
 }
 
@@ -373,14 +363,16 @@ impl Mechanics {
         (l, m2): (f64, f64),
     ) {
         let (visc, theta) = (self.visc(e, inp), self.theta(e, trace));
+        let mut t = Trial::default();
+        let mut sig = sigma::<D>(st, ex);
         if D::D == 2 {
-            let mut t = self.trial_2d(e, inp, st, ep, ex[0], theta);
-            add_hooke(l, m2, &t.de, &mut t.sig);
-            self.forces_2d(e, inp, sl, st, &mut ex[0], &t.sig, &t.rot, visc);
+            self.trial_2d(e, inp, ep, theta, &mut t);
+            add_hooke(l, m2, &t.de, &mut sig);
+            self.forces_2d(e, inp, sl, st, &mut ex[0], &sig, &t.rot, visc);
         } else {
-            let mut t = self.trial_3d(e, inp, st, ep, ex, theta);
-            add_hooke(l, m2, &t.de, &mut t.sig);
-            self.forces_3d(e, inp, sl, st, &t.sig, &t.rot, visc);
+            self.trial_3d(e, inp, ep, ex, theta, &mut t);
+            add_hooke(l, m2, &t.de, &mut sig);
+            self.forces_3d(e, inp, sl, st, &sig, &t.rot, visc);
         }
     }
 
@@ -405,7 +397,7 @@ impl Mechanics {
         let (d, npe, nsym) = (D::D, D::NODES_PER_ELEM, D::NSYM);
         let (nf, nx) = (npe * d, if d == 2 { 1 } else { 9 });
         let (ns, len) = (self.n_state.max(1), st.len() / nsym);
-        // Buffers for the chunk's runs, set once per chunk, not per run.
+        // Buffers for the chunk's runs, zeroed once per chunk, not per run or element.
         let mut trials = [Trial::default(); BATCH];
         let mut sigs = [[0.0; 6]; BATCH];
         let mut i = 0;
@@ -449,12 +441,13 @@ impl Mechanics {
                     &st[a * nsym..(a + 1) * nsym],
                     &mut ep[a * nsym..(a + 1) * nsym],
                 );
-                *t = if d == 2 {
-                    self.trial_2d(e, inp, s, p, ex[a], theta)
+                let x = &mut ex[a * nx..(a + 1) * nx];
+                sigs[b] = sigma::<D>(s, x);
+                if d == 2 {
+                    self.trial_2d(e, inp, p, theta, t);
                 } else {
-                    self.trial_3d(e, inp, s, p, &mut ex[a * nx..(a + 1) * nx], theta)
-                };
-                sigs[b] = t.sig;
+                    self.trial_3d(e, inp, p, x, theta, t);
+                }
             }
             let inputs: [ModelInput<'_>; BATCH] = std::array::from_fn(|b| {
                 let t = &trials[b.min(n - 1)];
