@@ -452,6 +452,7 @@ impl Surfaces {
     /// Plane k at principal stresses s (ordered sector): 0 the shear plane of eq. 29, 1
     /// and 2 the shear planes of the pyramid's edges (σ2 in place of σ3, of σ1), 3–5
     /// σ3, σ2, σ1 against σ_t.
+    #[inline(always)]
     pub fn plane(&self, k: usize, s: &[f64; 3]) -> f64 {
         match k {
             0 => self.n_phi * s[2] - s[0] - self.kc,
@@ -463,6 +464,7 @@ impl Surfaces {
         }
     }
 
+    #[inline(always)]
     fn gradient(&self, k: usize, n: f64) -> [f64; 3] {
         match k {
             0 => [-1.0, 0.0, n],
@@ -539,7 +541,7 @@ impl Surfaces {
         // the most violated plane of each result, up to three planes.
         let mut planes = [if self.h(s) <= 0.0 { 0 } else { 3 }, 0, 0];
         let mut n = 1;
-        while let Some(r) = self.solve(s, &planes[..n]) {
+        while let Some(r) = self.solve_likely(s, &planes[..n]) {
             if self.composite(&r.stress) <= tol {
                 return Some(r);
             }
@@ -590,8 +592,35 @@ impl Surfaces {
         best.map(|(_, r)| r)
     }
 
+    /// [`Self::solve`] with the sets nearly every return in compression takes (the
+    /// shear plane, then its edge with σ2 = σ3 or σ2 = σ1) in functions of their own
+    /// with constant planes, so that the compiler folds their gradients: the same
+    /// operations on the same values as the general solve (bit for bit), faster.
+    #[inline(always)]
+    fn solve_likely(&self, s: &[f64; 3], set: &[usize]) -> Option<Return> {
+        match *set {
+            [0] => self.solve_shear(s),
+            [0, 1] => self.solve_edge::<1>(s),
+            [0, 2] => self.solve_edge::<2>(s),
+            _ => self.solve(s, set),
+        }
+    }
+
+    /// [`Self::solve`] on the shear plane alone.
+    #[inline(never)]
+    fn solve_shear(&self, s: &[f64; 3]) -> Option<Return> {
+        self.solve_n(s, &[0])
+    }
+
+    /// [`Self::solve`] on the shear plane and plane `K` (1 or 2), in that order.
+    #[inline(never)]
+    fn solve_edge<const K: usize>(&self, s: &[f64; 3]) -> Option<Return> {
+        self.solve_n(s, &[0, K])
+    }
+
     /// The return onto the planes `set` together: λ from f_k(σ* − Σ_j λ_j D∇g_j) = 0;
     /// `None` when a multiplier is negative or the planes are dependent.
+    #[inline(never)]
     fn solve(&self, s: &[f64; 3], set: &[usize]) -> Option<Return> {
         // Fixed sizes, so that the loops unroll.
         match *set {
@@ -602,6 +631,7 @@ impl Surfaces {
         }
     }
 
+    #[inline(always)]
     fn solve_n<const N: usize>(&self, s: &[f64; 3], set: &[usize; N]) -> Option<Return> {
         let n = N;
         let mut dg = [[0.0; 3]; 3];
@@ -655,6 +685,7 @@ fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 
 /// Solves the leading n×n block of a x = b (n ≤ 3) by Gaussian elimination with partial
 /// pivoting; `None` if singular.
+#[inline(always)]
 fn solve_small<const N: usize>(a: &[[f64; 3]; 3], b: &[f64; 3]) -> Option<[f64; 3]> {
     let n = N;
     let (mut a, mut b) = (*a, *b);
