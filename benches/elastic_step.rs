@@ -33,7 +33,9 @@ use std::time::{Duration, Instant};
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 use pcdc_compute::{Backend, Precision, Simulation};
-use pcdc_mech::{Boundary, ConstitutiveModel, FaceStress, LinearElastic, Mechanics, MohrCoulomb};
+use pcdc_mech::{
+    principal, Boundary, ConstitutiveModel, FaceStress, LinearElastic, Mechanics, MohrCoulomb,
+};
 use pcdc_mesh::{builders, Dim, Mesh, Range};
 
 /// Steps per measured GPU iteration.
@@ -112,8 +114,9 @@ fn rotated(p: [f64; 3], deg: [f64; 3]) -> [f64; 6] {
         std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| x[i][k] * y[k][j]).sum()))
     };
     let r = mul(rz, mul(ry, rx));
-    let t = |i: usize, j: usize| (0..3).map(|k| r[i][k] * p[k] * r[j][k]).sum::<f64>();
-    [t(0, 0), t(1, 1), t(2, 2), t(0, 1), t(1, 2), t(0, 2)]
+    // The principal axes are R's columns.
+    let axes = std::array::from_fn(|i| [r[0][i], r[1][i], r[2][i]]);
+    principal::compose(&p, &axes)
 }
 
 /// Bottom held, top pushed at 0.05 m/s along y (2D) or z (3D).
