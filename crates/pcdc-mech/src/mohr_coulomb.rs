@@ -727,16 +727,17 @@ fn is_plane(t: &Sym6) -> bool {
 }
 
 impl MohrCoulomb {
-    /// The elastic trial σ + D Δε in `stress` and the step's flags cleared; false when
-    /// the trial is surely elastic ([`Surfaces::surely_elastic`] with the surfaces of
-    /// the element's plastic strains): then `stress` is the new stress.
+    /// The elastic trial σ + D Δε in `stress` and the step's flags cleared; `None`
+    /// when the trial is surely elastic ([`Surfaces::surely_elastic`]): then `stress`
+    /// is the new stress; else the surfaces of the element's plastic strains, for the
+    /// return (found once: with softening they cost four table look-ups).
     #[inline(always)]
-    fn trial(&self, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) -> bool {
+    fn trial(&self, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) -> Option<Surfaces> {
         add_hooke(self.lame.0, self.lame.1, de, stress);
         st[state::SHEAR_NOW] = 0.0;
         st[state::TENSION_NOW] = 0.0;
         let surfaces = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
-        !surfaces.surely_elastic(stress)
+        (!surfaces.surely_elastic(stress)).then_some(surfaces)
     }
 
     /// Returns a plane trial stress to the surfaces (closed-form principal stresses).
@@ -786,10 +787,9 @@ impl ConstitutiveModel for MohrCoulomb {
         MC_STATE
     }
     fn update(&self, _strain: &Sym6, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) {
-        if !self.trial(de, stress, st) {
+        let Some(surfaces) = self.trial(de, stress, st) else {
             return;
-        }
-        let surfaces = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
+        };
         // Plane strain in closed form, else Jacobi (the same values to rounding).
         if is_plane(stress) {
             self.plastic_plane(&surfaces, stress, st);
@@ -823,11 +823,14 @@ impl ConstitutiveModel for MohrCoulomb {
             // stresses, plane ones (closed form) and 3D ones (Jacobi) apart.
             let (mut plane_wait, mut wait) = ([0usize; BLOCK], [0usize; BLOCK]);
             let (mut np, mut n) = (0, 0);
+            // The surfaces of each waiting element's plastic strains, from its trial.
+            let mut surfaces = [Surfaces::default(); BLOCK];
             for (i, (x, s)) in inputs.iter().zip(stresses.iter_mut()).enumerate() {
                 let st = &mut states[i * stride..(i + 1) * stride];
-                if !self.trial(x.dstrain, s, st) {
+                let Some(f) = self.trial(x.dstrain, s, st) else {
                     continue;
-                }
+                };
+                surfaces[i] = f;
                 if is_plane(s) {
                     plane_wait[np] = i;
                     np += 1;
@@ -836,18 +839,15 @@ impl ConstitutiveModel for MohrCoulomb {
                     n += 1;
                 }
             }
-            // The surfaces of the element's plastic strains (unchanged since the trial).
-            let surfaces =
-                |st: &[f64]| self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
             for &i in &plane_wait[..np] {
                 let st = &mut states[i * stride..];
-                self.plastic_plane(&surfaces(st), &mut stresses[i], st);
+                self.plastic_plane(&surfaces[i], &mut stresses[i], st);
             }
             for group in wait[..n].chunks(LANES) {
                 if group.len() <= 2 {
                     for &i in group {
                         let (p, st) = (principal(&stresses[i]), &mut states[i * stride..]);
-                        self.plastic(&surfaces(st), &p, &mut stresses[i], st);
+                        self.plastic(&surfaces[i], &p, &mut stresses[i], st);
                     }
                     continue;
                 }
@@ -856,7 +856,7 @@ impl ConstitutiveModel for MohrCoulomb {
                 let ps = principal_lanes(&ts);
                 for (&i, p) in group.iter().zip(&ps) {
                     let st = &mut states[i * stride..];
-                    self.plastic(&surfaces(st), p, &mut stresses[i], st);
+                    self.plastic(&surfaces[i], p, &mut stresses[i], st);
                 }
             }
         }
