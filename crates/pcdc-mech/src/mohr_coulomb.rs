@@ -103,6 +103,9 @@ pub struct MohrCoulomb {
     /// Derived once from the parameters: `update` runs per element per step.
     #[serde(skip_serializing)]
     surfaces: Surfaces,
+    /// The shear plane's return constants of `surfaces`, derived once.
+    #[serde(skip_serializing)]
+    shear_plane: ShearPlane,
     /// λ and 2μ of the elastic part (Pa), derived once.
     #[serde(skip_serializing)]
     lame: (f64, f64),
@@ -272,9 +275,11 @@ impl MohrCoulomb {
             tensile,
             softening: None,
             surfaces: Surfaces::default(),
+            shear_plane: ShearPlane::default(),
             lame,
         };
         m.surfaces = surfaces_of(&m.elastic, cohesion, friction_deg, dilation_deg, tensile);
+        m.shear_plane = ShearPlane::of(&m.surfaces);
         Ok(m)
     }
 
@@ -399,6 +404,39 @@ pub struct Surfaces {
 
 /// √3, for [`Surfaces::surely_elastic`].
 const SQRT_3: f64 = 1.732_050_807_568_877_2;
+
+/// The shear plane's return constants of a [`Surfaces`]: D∇g₀, ∇f₀·D∇g₀ and whether
+/// that 1×1 system is regular (the test of the general solve).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct ShearPlane {
+    dg: [f64; 3],
+    a: f64,
+    regular: bool,
+}
+
+impl ShearPlane {
+    fn of(f: &Surfaces) -> Self {
+        let dg = f.elastic(&f.potential_gradient(0));
+        let a = dot(&f.yield_gradient(0), &dg);
+        let norm = 0.0f64.max(a.abs());
+        ShearPlane {
+            dg,
+            a,
+            regular: a.abs() > 1e-12 * norm || a.is_nan(),
+        }
+    }
+}
+
+/// What [`MohrCoulomb::plane_shear_fast`] did with a plane trial.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum FastPlane {
+    /// Not outside the surface: nothing to do.
+    Elastic,
+    /// Returned onto the shear plane with this multiplier; the history not yet written.
+    Shear(f64),
+    /// Another return: the general path's (nothing done).
+    Other,
+}
 
 /// Number of yield planes in the ordered sector.
 const PLANES: usize = 6;
@@ -679,6 +717,27 @@ impl Surfaces {
     }
 }
 
+/// The larger of two numbers that are not NaN (one instruction, where `f64::max` also
+/// handles NaN).
+#[inline(always)]
+fn max2(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// The smaller of two numbers that are not NaN (see [`max2`]).
+#[inline(always)]
+fn min2(a: f64, b: f64) -> f64 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
 fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -727,17 +786,15 @@ fn is_plane(t: &Sym6) -> bool {
 }
 
 impl MohrCoulomb {
-    /// The elastic trial σ + D Δε in `stress` and the step's flags cleared; `None`
-    /// when the trial is surely elastic ([`Surfaces::surely_elastic`]): then `stress`
-    /// is the new stress; else the surfaces of the element's plastic strains, for the
-    /// return (found once: with softening they cost four table look-ups).
+    /// The elastic trial σ + D Δε in `stress` and the step's flags cleared; false when
+    /// the trial is surely elastic against the element's surfaces `f`
+    /// ([`Surfaces::surely_elastic`]): then `stress` is the new stress.
     #[inline(always)]
-    fn trial(&self, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) -> Option<Surfaces> {
+    fn trial_with(&self, f: &Surfaces, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) -> bool {
         add_hooke(self.lame.0, self.lame.1, de, stress);
         st[state::SHEAR_NOW] = 0.0;
         st[state::TENSION_NOW] = 0.0;
-        let surfaces = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
-        (!surfaces.surely_elastic(stress)).then_some(surfaces)
+        !f.surely_elastic(stress)
     }
 
     /// Returns a plane trial stress to the surfaces (closed-form principal stresses).
@@ -747,6 +804,64 @@ impl MohrCoulomb {
             *stress = compose_plane(&r.stress, &p);
             record(&r, st);
         }
+    }
+
+    /// The plane-strain return when it ends on the shear plane at the first try of
+    /// [`Surfaces::return_map`], with the plane's constants found once: the same
+    /// operations on the same values (bit for bit). The history is left to
+    /// [`Self::record_shear`], so that a run's square roots there overlap.
+    #[inline(always)]
+    fn plane_shear_fast(&self, stress: &mut Sym6) -> FastPlane {
+        let (f, k) = (&self.surfaces, &self.shear_plane);
+        let p = plane(stress);
+        let s = &p.values;
+        // The composite yield function of ordered values, not outside: no return.
+        if f.n_phi * s[2] - s[0] - f.kc <= 0.0 && s[2] - f.st <= 0.0 {
+            return FastPlane::Elastic;
+        }
+        let lambda = f.plane(0, s) / k.a;
+        let h = f.h(s);
+        if h > 0.0 || h.is_nan() || !k.regular || lambda < 0.0 {
+            return FastPlane::Other;
+        }
+        let dg = &k.dg;
+        let o = [
+            s[0] - lambda * dg[0],
+            s[1] - lambda * dg[1],
+            s[2] - lambda * dg[2],
+        ];
+        // `composite(o) <= tol` of `return_map` with plain comparisons: the same where
+        // no value is NaN, and false (the general path) where one is.
+        let scale = max2(max2(max2(s[0].abs(), s[2].abs()), f.kc), f.st);
+        let tol = 1e-12 * max2(scale, f64::MIN_POSITIVE);
+        let (hi, lo) = (max2(max2(o[0], o[1]), o[2]), min2(min2(o[0], o[1]), o[2]));
+        if !(f.n_phi * hi - lo - f.kc <= tol && hi - f.st <= tol) {
+            return FastPlane::Other;
+        }
+        *stress = compose_plane(&o, &p);
+        FastPlane::Shear(lambda)
+    }
+
+    /// What the shear-plane return with multiplier `lambda` leaves in the history: as
+    /// [`record`] of that return.
+    #[inline(always)]
+    fn record_shear(&self, lambda: f64, st: &mut [f64]) {
+        // λ ∇g₀ summed from zero as `solve_n` does (0 + λ·(−1) is 0 − λ, exactly).
+        let ep = [
+            0.0 - lambda,
+            0.0 + lambda * 0.0,
+            0.0 + lambda * self.surfaces.n_psi,
+        ];
+        record(
+            &Return {
+                stress: [0.0; 3],
+                plastic_strain: ep,
+                shear_strain: ep,
+                shear: 0.0 + lambda,
+                tension: 0.0,
+            },
+            st,
+        );
     }
 
     /// Returns a trial stress with principal decomposition `p` to the surfaces.
@@ -787,9 +902,10 @@ impl ConstitutiveModel for MohrCoulomb {
         MC_STATE
     }
     fn update(&self, _strain: &Sym6, de: &Sym6, stress: &mut Sym6, st: &mut [f64]) {
-        let Some(surfaces) = self.trial(de, stress, st) else {
+        let surfaces = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
+        if !self.trial_with(&surfaces, de, stress, st) {
             return;
-        };
+        }
         // Plane strain in closed form, else Jacobi (the same values to rounding).
         if is_plane(stress) {
             self.plastic_plane(&surfaces, stress, st);
@@ -819,35 +935,69 @@ impl ConstitutiveModel for MohrCoulomb {
             .zip(stresses.chunks_mut(BLOCK))
             .zip(states.chunks_mut(BLOCK * stride));
         for ((inputs, stresses), states) in blocks {
-            // The elastic trials first; those that may yield wait for their principal
-            // stresses, plane ones (closed form) and 3D ones (Jacobi) apart.
-            let (mut plane_wait, mut wait) = ([0usize; BLOCK], [0usize; BLOCK]);
-            let (mut np, mut n) = (0, 0);
-            // The surfaces of each waiting element's plastic strains, from its trial.
+            // The elastic trials first, with the surfaces of each element's plastic
+            // strains (looked up only with softening); those not surely elastic are
+            // candidates.
             let mut surfaces = [Surfaces::default(); BLOCK];
+            let (mut cand, mut nc) = ([0usize; BLOCK], 0);
             for (i, (x, s)) in inputs.iter().zip(stresses.iter_mut()).enumerate() {
                 let st = &mut states[i * stride..(i + 1) * stride];
-                let Some(f) = self.trial(x.dstrain, s, st) else {
-                    continue;
+                let yields = match self.softening {
+                    None => self.trial_with(&self.surfaces, x.dstrain, s, st),
+                    Some(_) => {
+                        let f =
+                            self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
+                        surfaces[i] = f;
+                        self.trial_with(&f, x.dstrain, s, st)
+                    }
                 };
-                surfaces[i] = f;
-                if is_plane(s) {
-                    plane_wait[np] = i;
-                    np += 1;
-                } else {
+                cand[nc] = i;
+                nc += usize::from(yields);
+            }
+            let f_of = |i: usize| match self.softening {
+                None => &self.surfaces,
+                Some(_) => &surfaces[i],
+            };
+            // Then the candidates: plane ones with constant surfaces straight onto the
+            // shear plane where they can (histories written after the run, so that the
+            // square roots there overlap); the others wait for the general return, plane
+            // ones (closed form) and 3D ones (Jacobi) apart.
+            let (mut plane_wait, mut wait) = ([0usize; BLOCK], [0usize; BLOCK]);
+            let (mut np, mut n) = (0, 0);
+            let (mut shear, mut ns) = ([(0usize, 0.0f64); BLOCK], 0);
+            for &i in &cand[..nc] {
+                let s = &mut stresses[i];
+                if !is_plane(s) {
                     wait[n] = i;
                     n += 1;
+                    continue;
                 }
+                if self.softening.is_none() {
+                    match self.plane_shear_fast(s) {
+                        FastPlane::Elastic => continue,
+                        FastPlane::Shear(lambda) => {
+                            shear[ns] = (i, lambda);
+                            ns += 1;
+                            continue;
+                        }
+                        FastPlane::Other => {}
+                    }
+                }
+                plane_wait[np] = i;
+                np += 1;
+            }
+            for &(i, lambda) in &shear[..ns] {
+                self.record_shear(lambda, &mut states[i * stride..]);
             }
             for &i in &plane_wait[..np] {
                 let st = &mut states[i * stride..];
-                self.plastic_plane(&surfaces[i], &mut stresses[i], st);
+                self.plastic_plane(f_of(i), &mut stresses[i], st);
             }
             for group in wait[..n].chunks(LANES) {
                 if group.len() <= 2 {
                     for &i in group {
                         let (p, st) = (principal(&stresses[i]), &mut states[i * stride..]);
-                        self.plastic(&surfaces[i], &p, &mut stresses[i], st);
+                        self.plastic(f_of(i), &p, &mut stresses[i], st);
                     }
                     continue;
                 }
@@ -856,7 +1006,7 @@ impl ConstitutiveModel for MohrCoulomb {
                 let ps = principal_lanes(&ts);
                 for (&i, p) in group.iter().zip(&ps) {
                     let st = &mut states[i * stride..];
-                    self.plastic(&surfaces[i], p, &mut stresses[i], st);
+                    self.plastic(f_of(i), p, &mut stresses[i], st);
                 }
             }
         }
