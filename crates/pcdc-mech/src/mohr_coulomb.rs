@@ -427,13 +427,14 @@ impl ShearPlane {
     }
 }
 
-/// What [`MohrCoulomb::plane_shear_fast`] did with a plane trial.
+/// What [`MohrCoulomb::shear_first`] found for a trial.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum FastPlane {
+enum FirstTry {
     /// Not outside the surface: nothing to do.
     Elastic,
-    /// Returned onto the shear plane with this multiplier; the history not yet written.
-    Shear(f64),
+    /// Returned onto the shear plane with this multiplier to these principal stresses;
+    /// the history not yet written.
+    Shear(f64, [f64; 3]),
     /// Another return: the general path's (nothing done).
     Other,
 }
@@ -806,23 +807,22 @@ impl MohrCoulomb {
         }
     }
 
-    /// The plane-strain return when it ends on the shear plane at the first try of
-    /// [`Surfaces::return_map`], with the plane's constants found once: the same
-    /// operations on the same values (bit for bit). The history is left to
+    /// The return of ordered principal trial stresses `s` when, with the constant
+    /// surfaces, it ends on the shear plane at the first try of
+    /// [`Surfaces::return_map`]: the plane's constants found once, the same operations
+    /// on the same values (bit for bit). The history is left to
     /// [`Self::record_shear`], so that a run's square roots there overlap.
     #[inline(always)]
-    fn plane_shear_fast(&self, stress: &mut Sym6) -> FastPlane {
+    fn shear_first(&self, s: &[f64; 3]) -> FirstTry {
         let (f, k) = (&self.surfaces, &self.shear_plane);
-        let p = plane(stress);
-        let s = &p.values;
         // The composite yield function of ordered values, not outside: no return.
         if f.n_phi * s[2] - s[0] - f.kc <= 0.0 && s[2] - f.st <= 0.0 {
-            return FastPlane::Elastic;
+            return FirstTry::Elastic;
         }
         let lambda = f.plane(0, s) / k.a;
         let h = f.h(s);
         if h > 0.0 || h.is_nan() || !k.regular || lambda < 0.0 {
-            return FastPlane::Other;
+            return FirstTry::Other;
         }
         let dg = &k.dg;
         let o = [
@@ -836,10 +836,9 @@ impl MohrCoulomb {
         let tol = 1e-12 * max2(scale, f64::MIN_POSITIVE);
         let (hi, lo) = (max2(max2(o[0], o[1]), o[2]), min2(min2(o[0], o[1]), o[2]));
         if !(f.n_phi * hi - lo - f.kc <= tol && hi - f.st <= tol) {
-            return FastPlane::Other;
+            return FirstTry::Other;
         }
-        *stress = compose_plane(&o, &p);
-        FastPlane::Shear(lambda)
+        FirstTry::Shear(lambda, o)
     }
 
     /// What the shear-plane return with multiplier `lambda` leaves in the history: as
@@ -973,41 +972,60 @@ impl ConstitutiveModel for MohrCoulomb {
                     continue;
                 }
                 if self.softening.is_none() {
-                    match self.plane_shear_fast(s) {
-                        FastPlane::Elastic => continue,
-                        FastPlane::Shear(lambda) => {
+                    let p = plane(s);
+                    match self.shear_first(&p.values) {
+                        FirstTry::Elastic => continue,
+                        FirstTry::Shear(lambda, o) => {
+                            *s = compose_plane(&o, &p);
                             shear[ns] = (i, lambda);
                             ns += 1;
                             continue;
                         }
-                        FastPlane::Other => {}
+                        FirstTry::Other => {}
                     }
                 }
                 plane_wait[np] = i;
                 np += 1;
             }
-            for &(i, lambda) in &shear[..ns] {
-                self.record_shear(lambda, &mut states[i * stride..]);
-            }
             for &i in &plane_wait[..np] {
                 let st = &mut states[i * stride..];
                 self.plastic_plane(f_of(i), &mut stresses[i], st);
             }
+            // The 3D ones: their decompositions, [`LANES`] at a time where there are
+            // enough, then with constant surfaces the shear plane at once if it is the
+            // return, else the general return.
             for group in wait[..n].chunks(LANES) {
-                if group.len() <= 2 {
-                    for &i in group {
-                        let (p, st) = (principal(&stresses[i]), &mut states[i * stride..]);
-                        self.plastic(f_of(i), &p, &mut stresses[i], st);
-                    }
-                    continue;
-                }
-                // Unused lanes get a zero tensor, which needs no rotation.
-                let ts = std::array::from_fn(|l| group.get(l).map_or([0.0; 6], |&i| stresses[i]));
-                let ps = principal_lanes(&ts);
+                let ps: [Principal; LANES] = if group.len() <= 2 {
+                    let none = Principal {
+                        values: [0.0; 3],
+                        axes: [[0.0; 3]; 3],
+                    };
+                    std::array::from_fn(|l| group.get(l).map_or(none, |&i| principal(&stresses[i])))
+                } else {
+                    // Unused lanes get a zero tensor, which needs no rotation.
+                    let ts =
+                        std::array::from_fn(|l| group.get(l).map_or([0.0; 6], |&i| stresses[i]));
+                    principal_lanes(&ts)
+                };
                 for (&i, p) in group.iter().zip(&ps) {
+                    if self.softening.is_none() {
+                        match self.shear_first(&p.values) {
+                            FirstTry::Elastic => continue,
+                            FirstTry::Shear(lambda, o) => {
+                                stresses[i] = compose(&o, &p.axes);
+                                shear[ns] = (i, lambda);
+                                ns += 1;
+                                continue;
+                            }
+                            FirstTry::Other => {}
+                        }
+                    }
                     let st = &mut states[i * stride..];
                     self.plastic(f_of(i), p, &mut stresses[i], st);
                 }
+            }
+            for &(i, lambda) in &shear[..ns] {
+                self.record_shear(lambda, &mut states[i * stride..]);
             }
         }
     }
