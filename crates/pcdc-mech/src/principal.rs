@@ -121,9 +121,10 @@ pub fn principal_lanes(ts: &[Sym6; LANES]) -> [Principal; LANES] {
         if !live.iter().any(|&on| on) {
             break;
         }
-        for (p, q) in [(0, 1), (1, 2), (0, 2)] {
-            rotate_lanes(&mut a, &mut v, p, q, &live);
-        }
+        // Written out, so that each rotation's indices are constants.
+        rotate_lanes(&mut a, &mut v, 0, 1, &live);
+        rotate_lanes(&mut a, &mut v, 1, 2, &live);
+        rotate_lanes(&mut a, &mut v, 0, 2, &live);
     }
     std::array::from_fn(|l| {
         ascending([a[0][0][l], a[1][1][l], a[2][2][l]], |k| {
