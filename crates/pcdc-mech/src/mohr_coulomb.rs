@@ -916,7 +916,10 @@ impl ConstitutiveModel for MohrCoulomb {
     /// As [`MohrCoulomb::update`] for each element, bit for bit, with the 3D principal
     /// decompositions of the elements that need one done [`LANES`] at a time
     /// ([`principal_lanes`]): one Jacobi decomposition is a chain of dependent roots and
-    /// divisions, and several side by side cost little more than one.
+    /// divisions, and several side by side cost little more than one. With constant
+    /// strengths (no softening) a return that ends on the shear plane at the first try
+    /// skips the general return (`shear_first`: the same operations, its constants
+    /// found once), and the histories of those returns are written after the run.
     fn update_many(
         &self,
         inputs: &[ModelInput<'_>],
