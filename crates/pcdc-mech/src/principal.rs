@@ -85,9 +85,10 @@ pub const LANES: usize = 8;
 type LaneMatrix = [[[f64; LANES]; 3]; 3];
 
 /// [`principal`] of [`LANES`] tensors at once, with the same result for each, bit for
-/// bit: the lanes run the same rotations in lockstep, each lane's rotation masked to
-/// the identity (its entries kept, not recomputed) where [`principal`] would skip it or
-/// has stopped. The point is speed: a rotation is a chain of a root, a division and a
+/// bit (but for the sign of an entry that is exactly zero, which an idle lane's
+/// identity rotation may turn from −0 to +0): the lanes run the same rotations in
+/// lockstep, each lane's rotation replaced by the identity where [`principal`] would
+/// skip it or has stopped. The point is speed: a rotation is a chain of a root, a division and a
 /// root, and one tensor's rotations depend on each other, so one decomposition waits on
 /// that chain; four independent chains side by side keep the divider busy and fit in
 /// vector registers.
@@ -134,11 +135,14 @@ pub fn principal_lanes(ts: &[Sym6; LANES]) -> [Principal; LANES] {
 }
 
 /// [`rotate`] in every lane where `on` is set, with the same operations; a lane that is
-/// off, or whose rotation [`rotate`] skips (a_pq = 0, or underflow), keeps its entries.
+/// off, or whose rotation [`rotate`] skips (a_pq = 0, or underflow), keeps its entries
+/// (see [`principal_lanes`] on the sign of zeros).
 #[inline(always)]
 fn rotate_lanes(a: &mut LaneMatrix, v: &mut LaneMatrix, p: usize, q: usize, on: &[bool; LANES]) {
     let r = 3 - p - q;
-    // Per lane: the rotation's t, c, s, and whether it applies.
+    // Per lane: the rotation's t, c, s where it applies, else the identity (t = s = 0,
+    // c = 1), which leaves every entry as it is (but a_pq, kept by a select, and the
+    // sign of an entry that is exactly zero): a select for every entry costs more.
     let (mut t, mut c, mut s, mut go) = ([0.0; LANES], [0.0; LANES], [0.0; LANES], [false; LANES]);
     for l in 0..LANES {
         let apq = a[p][q][l];
@@ -146,29 +150,29 @@ fn rotate_lanes(a: &mut LaneMatrix, v: &mut LaneMatrix, p: usize, q: usize, on: 
         let rho = (d * d + 4.0 * apq * apq).sqrt();
         let e = rho + d.abs();
         let tl = 2.0 * apq / e;
-        t[l] = if d >= 0.0 { tl } else { -tl };
-        c[l] = (e / (2.0 * rho)).sqrt();
-        s[l] = t[l] * c[l];
-        go[l] = on[l] && apq != 0.0 && e > 0.0;
+        let m = on[l] && apq != 0.0 && e > 0.0;
+        let tt = if d >= 0.0 { tl } else { -tl };
+        let cc = (e / (2.0 * rho)).sqrt();
+        t[l] = if m { tt } else { 0.0 };
+        c[l] = if m { cc } else { 1.0 };
+        s[l] = if m { tt * cc } else { 0.0 };
+        go[l] = m;
     }
-    // The new entry where the rotation applies, else the old one, bit for bit.
-    let pick = |old: f64, new: f64, m: bool| if m { new } else { old };
     for l in 0..LANES {
-        let m = go[l];
         let (app, aqq, apq) = (a[p][p][l], a[q][q][l], a[p][q][l]);
         let (apr, aqr) = (a[p][r][l], a[q][r][l]);
-        a[p][p][l] = pick(app, app - t[l] * apq, m);
-        a[q][q][l] = pick(aqq, aqq + t[l] * apq, m);
-        a[p][q][l] = pick(apq, 0.0, m);
+        a[p][p][l] = app - t[l] * apq;
+        a[q][q][l] = aqq + t[l] * apq;
+        a[p][q][l] = if go[l] { 0.0 } else { apq };
         a[q][p][l] = a[p][q][l];
-        a[p][r][l] = pick(apr, c[l] * apr - s[l] * aqr, m);
+        a[p][r][l] = c[l] * apr - s[l] * aqr;
         a[r][p][l] = a[p][r][l];
-        a[q][r][l] = pick(aqr, s[l] * apr + c[l] * aqr, m);
+        a[q][r][l] = s[l] * apr + c[l] * aqr;
         a[r][q][l] = a[q][r][l];
         for row in v.iter_mut() {
             let (vp, vq) = (row[p][l], row[q][l]);
-            row[p][l] = pick(vp, c[l] * vp - s[l] * vq, m);
-            row[q][l] = pick(vq, s[l] * vp + c[l] * vq, m);
+            row[p][l] = c[l] * vp - s[l] * vq;
+            row[q][l] = s[l] * vp + c[l] * vq;
         }
     }
 }
