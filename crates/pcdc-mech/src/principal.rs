@@ -92,7 +92,35 @@ type LaneMatrix = [[[f64; LANES]; 3]; 3];
 /// root, and one tensor's rotations depend on each other, so one decomposition waits on
 /// that chain; four independent chains side by side keep the divider busy and fit in
 /// vector registers.
+///
+/// On x86-64 processors with AVX2 the lanes run in 256-bit vectors (detected at run
+/// time; the default build targets baseline x86-64, whose 128-bit vectors hold two
+/// lanes): the same operations, without fused multiply-adds, so the same results bit
+/// for bit on every processor.
 pub fn principal_lanes(ts: &[Sym6; LANES]) -> [Principal; LANES] {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the processor has AVX2, checked on the line above.
+        return unsafe { principal_lanes_avx2(ts) };
+    }
+    principal_lanes_any(ts)
+}
+
+/// [`principal_lanes_any`] compiled for AVX2 (probe: 99 → 71 ns per tensor on an AMD
+/// EPYC).
+///
+/// # Safety
+///
+/// The processor must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn principal_lanes_avx2(ts: &[Sym6; LANES]) -> [Principal; LANES] {
+    principal_lanes_any(ts)
+}
+
+/// The body of [`principal_lanes`], inlined into each instruction-set version.
+#[inline(always)]
+fn principal_lanes_any(ts: &[Sym6; LANES]) -> [Principal; LANES] {
     let mut a: LaneMatrix = [[[0.0; LANES]; 3]; 3];
     let mut v: LaneMatrix = [[[0.0; LANES]; 3]; 3];
     let mut plane = [false; LANES];
@@ -436,7 +464,8 @@ mod tests {
 
     proptest::proptest! {
         /// The lanes give each tensor what [`principal`] gives it, bit for bit: plane and
-        /// 3D tensors, diagonal ones and ones of every off-diagonal size side by side.
+        /// 3D tensors, diagonal ones and ones of every off-diagonal size side by side;
+        /// the AVX2 and the portable build of the lanes alike.
         #[test]
         fn lanes_are_the_one_tensor_decomposition_bit_for_bit(
             ts in proptest::array::uniform8((
@@ -456,7 +485,14 @@ mod tests {
                 t.map(|v| v * 3e7)
             });
             let lanes = principal_lanes(&ts);
-            for (t, q) in ts.iter().zip(&lanes) {
+            // The portable version too, where the run-time dispatch picks AVX2.
+            let portable = principal_lanes_any(&ts);
+            for ((t, q), r) in ts.iter().zip(&lanes).zip(&portable) {
+                proptest::prop_assert_eq!(q.values.map(f64::to_bits), r.values.map(f64::to_bits));
+                proptest::prop_assert_eq!(
+                    q.axes.map(|a| a.map(f64::to_bits)),
+                    r.axes.map(|a| a.map(f64::to_bits))
+                );
                 let p = principal(t);
                 proptest::prop_assert_eq!(p.values.map(f64::to_bits), q.values.map(f64::to_bits));
                 proptest::prop_assert_eq!(
