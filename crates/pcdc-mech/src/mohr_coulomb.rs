@@ -103,9 +103,6 @@ pub struct MohrCoulomb {
     /// Derived once from the parameters: `update` runs per element per step.
     #[serde(skip_serializing)]
     surfaces: Surfaces,
-    /// The shear plane's return constants of `surfaces`, derived once.
-    #[serde(skip_serializing)]
-    shear_plane: ShearPlane,
     /// λ and 2μ of the elastic part (Pa), derived once.
     #[serde(skip_serializing)]
     lame: (f64, f64),
@@ -275,11 +272,9 @@ impl MohrCoulomb {
             tensile,
             softening: None,
             surfaces: Surfaces::default(),
-            shear_plane: ShearPlane::default(),
             lame,
         };
         m.surfaces = surfaces_of(&m.elastic, cohesion, friction_deg, dilation_deg, tensile);
-        m.shear_plane = ShearPlane::of(&m.surfaces);
         Ok(m)
     }
 
@@ -405,29 +400,7 @@ pub struct Surfaces {
 /// √3, for [`Surfaces::surely_elastic`].
 const SQRT_3: f64 = 1.732_050_807_568_877_2;
 
-/// The shear plane's return constants of a [`Surfaces`]: D∇g₀, ∇f₀·D∇g₀ and whether
-/// that 1×1 system is regular (the test of the general solve).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct ShearPlane {
-    dg: [f64; 3],
-    a: f64,
-    regular: bool,
-}
-
-impl ShearPlane {
-    fn of(f: &Surfaces) -> Self {
-        let dg = f.elastic(&f.potential_gradient(0));
-        let a = dot(&f.yield_gradient(0), &dg);
-        let norm = 0.0f64.max(a.abs());
-        ShearPlane {
-            dg,
-            a,
-            regular: a.abs() > 1e-12 * norm || a.is_nan(),
-        }
-    }
-}
-
-/// What [`MohrCoulomb::shear_first`] found for a trial.
+/// What [`Surfaces::shear_first`] found for a trial.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum FirstTry {
     /// Not outside the surface: nothing to do.
@@ -571,6 +544,14 @@ impl Surfaces {
     /// Returns the ordered trial principal stresses `s` (σ1 ≤ σ2 ≤ σ3) to the yield
     /// surface, or `None` when `s` is not outside it.
     pub fn return_map(&self, s: &[f64; 3]) -> Option<Return> {
+        // Nearly every return in compression: the shear plane at the first try.
+        match self.shear_first(s) {
+            FirstTry::Elastic => return None,
+            FirstTry::Shear(lambda, stress) => {
+                return Some(shear_return(lambda, stress, self.n_psi))
+            }
+            FirstTry::Other => {}
+        }
         let scale = s[0].abs().max(s[2].abs()).max(self.kc).max(self.st);
         if self.composite(s) <= 0.0 {
             return None;
@@ -629,6 +610,46 @@ impl Surfaces {
             }
         }
         best.map(|(_, r)| r)
+    }
+
+    /// The first try of [`Self::return_map`] for ordered principal trial stresses `s`:
+    /// not outside the surface, or the return onto the shear plane alone when that is
+    /// the result (its multiplier and principal stresses), or neither (`Other`: the
+    /// general search). The same operations on the same values as that search's first
+    /// solve and checks (bit for bit), with no [`Return`] built, so that a run of
+    /// elements ([`MohrCoulomb::update_many`]) can take it straight from the trial.
+    #[inline(always)]
+    fn shear_first(&self, s: &[f64; 3]) -> FirstTry {
+        // The composite yield function of ordered values, not outside: no return.
+        if self.n_phi * s[2] - s[0] - self.kc <= 0.0 && s[2] - self.st <= 0.0 {
+            return FirstTry::Elastic;
+        }
+        let h = self.h(s);
+        if h > 0.0 || h.is_nan() {
+            return FirstTry::Other;
+        }
+        // `solve_n` on the shear plane: the 1×1 system, its pivot test, λ ≥ 0.
+        let dg = self.elastic(&self.potential_gradient(0));
+        let a = dot(&self.yield_gradient(0), &dg);
+        let singular = a.abs() <= 1e-12 * 0.0f64.max(a.abs());
+        let lambda = self.plane(0, s) / a;
+        if singular || lambda < 0.0 {
+            return FirstTry::Other;
+        }
+        let o = [
+            s[0] - lambda * dg[0],
+            s[1] - lambda * dg[1],
+            s[2] - lambda * dg[2],
+        ];
+        // `composite(o) <= tol` with plain comparisons: the same where no value is NaN,
+        // and false (the general search) where one is.
+        let scale = max2(max2(max2(s[0].abs(), s[2].abs()), self.kc), self.st);
+        let tol = 1e-12 * max2(scale, f64::MIN_POSITIVE);
+        let (hi, lo) = (max2(max2(o[0], o[1]), o[2]), min2(min2(o[0], o[1]), o[2]));
+        if !(self.n_phi * hi - lo - self.kc <= tol && hi - self.st <= tol) {
+            return FirstTry::Other;
+        }
+        FirstTry::Shear(lambda, o)
     }
 
     /// [`Self::solve`] with the sets nearly every return in compression takes (the
@@ -807,68 +828,27 @@ impl MohrCoulomb {
         }
     }
 
-    /// The return of ordered principal trial stresses `s` when, with the constant
-    /// surfaces, it ends on the shear plane at the first try of
-    /// [`Surfaces::return_map`]: the plane's constants found once, the same operations
-    /// on the same values (bit for bit). The history is left to
-    /// [`Self::record_shear`], so that a run's square roots there overlap.
-    #[inline(always)]
-    fn shear_first(&self, s: &[f64; 3]) -> FirstTry {
-        let (f, k) = (&self.surfaces, &self.shear_plane);
-        // The composite yield function of ordered values, not outside: no return.
-        if f.n_phi * s[2] - s[0] - f.kc <= 0.0 && s[2] - f.st <= 0.0 {
-            return FirstTry::Elastic;
-        }
-        let lambda = f.plane(0, s) / k.a;
-        let h = f.h(s);
-        if h > 0.0 || h.is_nan() || !k.regular || lambda < 0.0 {
-            return FirstTry::Other;
-        }
-        let dg = &k.dg;
-        let o = [
-            s[0] - lambda * dg[0],
-            s[1] - lambda * dg[1],
-            s[2] - lambda * dg[2],
-        ];
-        // `composite(o) <= tol` of `return_map` with plain comparisons: the same where
-        // no value is NaN, and false (the general path) where one is.
-        let scale = max2(max2(max2(s[0].abs(), s[2].abs()), f.kc), f.st);
-        let tol = 1e-12 * max2(scale, f64::MIN_POSITIVE);
-        let (hi, lo) = (max2(max2(o[0], o[1]), o[2]), min2(min2(o[0], o[1]), o[2]));
-        if !(f.n_phi * hi - lo - f.kc <= tol && hi - f.st <= tol) {
-            return FirstTry::Other;
-        }
-        FirstTry::Shear(lambda, o)
-    }
-
-    /// What the shear-plane return with multiplier `lambda` leaves in the history: as
-    /// [`record`] of that return.
-    #[inline(always)]
-    fn record_shear(&self, lambda: f64, st: &mut [f64]) {
-        // λ ∇g₀ summed from zero as `solve_n` does (0 + λ·(−1) is 0 − λ, exactly).
-        let ep = [
-            0.0 - lambda,
-            0.0 + lambda * 0.0,
-            0.0 + lambda * self.surfaces.n_psi,
-        ];
-        record(
-            &Return {
-                stress: [0.0; 3],
-                plastic_strain: ep,
-                shear_strain: ep,
-                shear: 0.0 + lambda,
-                tension: 0.0,
-            },
-            st,
-        );
-    }
-
     /// Returns a trial stress with principal decomposition `p` to the surfaces.
     fn plastic(&self, surfaces: &Surfaces, p: &Principal, stress: &mut Sym6, st: &mut [f64]) {
         if let Some(r) = surfaces.return_map(&p.values) {
             *stress = compose(&r.stress, &p.axes);
             record(&r, st);
         }
+    }
+}
+
+/// The [`Return`] of a return onto the shear plane alone with multiplier `lambda` to
+/// principal stresses `stress` (dilation N_ψ `n_psi`): λ∇g₀ summed from zero as
+/// `solve_n` sums it (0 + λ·(−1) is 0 − λ, exactly).
+#[inline(always)]
+fn shear_return(lambda: f64, stress: [f64; 3], n_psi: f64) -> Return {
+    let ep = [0.0 - lambda, 0.0 + lambda * 0.0, 0.0 + lambda * n_psi];
+    Return {
+        stress,
+        plastic_strain: ep,
+        shear_strain: ep,
+        shear: 0.0 + lambda,
+        tension: 0.0,
     }
 }
 
@@ -916,10 +896,11 @@ impl ConstitutiveModel for MohrCoulomb {
     /// As [`MohrCoulomb::update`] for each element, bit for bit, with the 3D principal
     /// decompositions of the elements that need one done [`LANES`] at a time
     /// ([`principal_lanes`]): one Jacobi decomposition is a chain of dependent roots and
-    /// divisions, and several side by side cost little more than one. With constant
-    /// strengths (no softening) a return that ends on the shear plane at the first try
-    /// skips the general return (`shear_first`: the same operations, its constants
-    /// found once), and the histories of those returns are written after the run.
+    /// divisions, and several side by side cost little more than one. A return that
+    /// ends on the shear plane at the first try is taken straight from the
+    /// decomposition (`Surfaces::shear_first`, the first step of
+    /// [`Surfaces::return_map`]), and the histories of those returns are written after
+    /// the run.
     fn update_many(
         &self,
         inputs: &[ModelInput<'_>],
@@ -960,13 +941,13 @@ impl ConstitutiveModel for MohrCoulomb {
                 None => &self.surfaces,
                 Some(_) => &surfaces[i],
             };
-            // Then the candidates: plane ones with constant surfaces straight onto the
-            // shear plane where they can (histories written after the run, so that the
-            // square roots there overlap); the others wait for the general return, plane
-            // ones (closed form) and 3D ones (Jacobi) apart.
+            // Then the candidates: plane ones straight onto the shear plane where that is
+            // the return (histories written after the run, so that the square roots
+            // there overlap); the others wait for the general return, plane ones (closed
+            // form) and 3D ones (Jacobi) apart.
             let (mut plane_wait, mut wait) = ([0usize; BLOCK], [0usize; BLOCK]);
             let (mut np, mut n) = (0, 0);
-            let (mut shear, mut ns) = ([(0usize, 0.0f64); BLOCK], 0);
+            let (mut shear, mut ns) = ([(0usize, 0.0f64, 0.0f64); BLOCK], 0);
             for &i in &cand[..nc] {
                 let s = &mut stresses[i];
                 if !is_plane(s) {
@@ -974,18 +955,16 @@ impl ConstitutiveModel for MohrCoulomb {
                     n += 1;
                     continue;
                 }
-                if self.softening.is_none() {
-                    let p = plane(s);
-                    match self.shear_first(&p.values) {
-                        FirstTry::Elastic => continue,
-                        FirstTry::Shear(lambda, o) => {
-                            *s = compose_plane(&o, &p);
-                            shear[ns] = (i, lambda);
-                            ns += 1;
-                            continue;
-                        }
-                        FirstTry::Other => {}
+                let (f, p) = (f_of(i), plane(s));
+                match f.shear_first(&p.values) {
+                    FirstTry::Elastic => continue,
+                    FirstTry::Shear(lambda, o) => {
+                        *s = compose_plane(&o, &p);
+                        shear[ns] = (i, lambda, f.n_psi);
+                        ns += 1;
+                        continue;
                     }
+                    FirstTry::Other => {}
                 }
                 plane_wait[np] = i;
                 np += 1;
@@ -1011,24 +990,26 @@ impl ConstitutiveModel for MohrCoulomb {
                     principal_lanes(&ts)
                 };
                 for (&i, p) in group.iter().zip(&ps) {
-                    if self.softening.is_none() {
-                        match self.shear_first(&p.values) {
-                            FirstTry::Elastic => continue,
-                            FirstTry::Shear(lambda, o) => {
-                                stresses[i] = compose(&o, &p.axes);
-                                shear[ns] = (i, lambda);
-                                ns += 1;
-                                continue;
-                            }
-                            FirstTry::Other => {}
+                    let f = f_of(i);
+                    match f.shear_first(&p.values) {
+                        FirstTry::Elastic => {}
+                        FirstTry::Shear(lambda, o) => {
+                            stresses[i] = compose(&o, &p.axes);
+                            shear[ns] = (i, lambda, f.n_psi);
+                            ns += 1;
+                        }
+                        FirstTry::Other => {
+                            let st = &mut states[i * stride..];
+                            self.plastic(f, p, &mut stresses[i], st);
                         }
                     }
-                    let st = &mut states[i * stride..];
-                    self.plastic(f_of(i), p, &mut stresses[i], st);
                 }
             }
-            for &(i, lambda) in &shear[..ns] {
-                self.record_shear(lambda, &mut states[i * stride..]);
+            for &(i, lambda, n_psi) in &shear[..ns] {
+                record(
+                    &shear_return(lambda, [0.0; 3], n_psi),
+                    &mut states[i * stride..],
+                );
             }
         }
     }
