@@ -542,7 +542,9 @@ impl Surfaces {
     }
 
     /// Returns the ordered trial principal stresses `s` (σ1 ≤ σ2 ≤ σ3) to the yield
-    /// surface, or `None` when `s` is not outside it.
+    /// surface, or `None` when `s` is not outside it. Whether `s` is outside is the
+    /// [`Self::composite`] function's answer for values in any order, so that an
+    /// unordered `s` outside is returned too (onto the planes its labels name).
     pub fn return_map(&self, s: &[f64; 3]) -> Option<Return> {
         // Nearly every return in compression: the shear plane at the first try.
         match self.shear_first(s) {
@@ -612,7 +614,8 @@ impl Surfaces {
         best.map(|(_, r)| r)
     }
 
-    /// The first try of [`Self::return_map`] for ordered principal trial stresses `s`:
+    /// The first try of [`Self::return_map`] for principal trial stresses `s` (ordered
+    /// in the update; the elastic check takes any order, as `composite` does):
     /// not outside the surface, or the return onto the shear plane alone when that is
     /// the result (its multiplier and principal stresses), or neither (`Other`: the
     /// general search). The same operations on the same values as that search's first
@@ -620,8 +623,11 @@ impl Surfaces {
     /// elements ([`MohrCoulomb::update_many`]) can take it straight from the trial.
     #[inline(always)]
     fn shear_first(&self, s: &[f64; 3]) -> FirstTry {
-        // The composite yield function of ordered values, not outside: no return.
-        if self.n_phi * s[2] - s[0] - self.kc <= 0.0 && s[2] - self.st <= 0.0 {
+        // The composite yield function, not outside: no return. Of the largest and the
+        // smallest value, not of s[2] and s[0]: a caller (or an edge's trial) may pass
+        // values out of order, and `composite` takes any order.
+        let (hi, lo) = (max2(max2(s[0], s[1]), s[2]), min2(min2(s[0], s[1]), s[2]));
+        if self.n_phi * hi - lo - self.kc <= 0.0 && hi - self.st <= 0.0 {
             return FirstTry::Elastic;
         }
         let h = self.h(s);

@@ -29,6 +29,34 @@ fn uniaxial_compression_yields_at_two_c_root_n() {
     assert!(r.shear > 0.0 && r.tension == 0.0);
 }
 
+/// Found by CI's proptest (`edge_returns_recover_both_multipliers`): a trial past the
+/// compression edge with the edge's multiplier the larger has σ2 > σ3 in its labels, and
+/// the shear plane's first try once judged it by σ3 alone, inside, so no return came.
+/// Whether a trial is outside is the composite function's answer in any order.
+#[test]
+fn an_unordered_trial_outside_is_returned() {
+    for poisson in [-0.05, 0.0, 0.25, 0.45] {
+        for (phi, psi, st) in [(52.5, 48.3, 0.0), (30.0, 10.0, 1e5), (10.0, 0.0, 0.0)] {
+            let e = LinearElastic::new(1e9, poisson, 2500.0).unwrap();
+            let m = MohrCoulomb::new(e, 1e5, phi, psi, st).unwrap();
+            let s = m.surfaces();
+            let s3 = s.st - 0.25 * s.kc;
+            let on = [s.n_phi * s3 - s.kc, s3, s3];
+            let (l0, l1) = (1e-6 * s.kc / s.a1, 7e-3 * s.kc / s.a1);
+            let g0 = s.elastic(&s.potential_gradient(0));
+            let g1 = s.elastic(&s.potential_gradient(1));
+            let trial = add(&add(&on, &g0, l0), &g1, l1);
+            assert!(
+                trial[1] > trial[2],
+                "the case needs labels out of order: {trial:?}"
+            );
+            assert!(s.composite(&trial) > 0.0, "{trial:?}");
+            let r = s.return_map(&trial).expect("outside, so returned");
+            assert!(s.composite(&r.stress) <= 1e-9 * s.kc, "{:?}", r.stress);
+        }
+    }
+}
+
 #[test]
 fn triaxial_yield_follows_sigma3_n_phi_plus_ucs() {
     // Yield at σ1 = σ3 N_φ + 2c√N_φ in compression magnitudes, for several confinements.
