@@ -397,6 +397,17 @@ pub struct Surfaces {
     pub alpha_p: f64,
 }
 
+/// The shear plane's constants of a [`Surfaces`] for its first try
+/// ([`Surfaces::shear_first`]): found once for a run of elements with the same surfaces,
+/// not per element.
+#[derive(Clone, Copy, Debug)]
+struct ShearPlane {
+    /// D∇g₀, the elastic image of the shear plane's flow direction (Pa).
+    dg: [f64; 3],
+    /// ∇f₀·D∇g₀ (Pa).
+    a: f64,
+}
+
 /// √3, for [`Surfaces::surely_elastic`].
 const SQRT_3: f64 = 1.732_050_807_568_877_2;
 
@@ -461,6 +472,17 @@ pub struct Return {
 }
 
 impl Surfaces {
+    /// The shear plane's constants for [`Self::shear_first`] (the same operations as
+    /// `solve_n` on the shear plane does).
+    #[inline(always)]
+    fn shear_plane(&self) -> ShearPlane {
+        let dg = self.elastic(&self.potential_gradient(0));
+        ShearPlane {
+            dg,
+            a: dot(&self.yield_gradient(0), &dg),
+        }
+    }
+
     /// Plane k at principal stresses s (ordered sector): 0 the shear plane of eq. 29, 1
     /// and 2 the shear planes of the pyramid's edges (σ2 in place of σ3, of σ1), 3–5
     /// σ3, σ2, σ1 against σ_t.
@@ -546,13 +568,17 @@ impl Surfaces {
     /// [`Self::composite`] function's answer for values in any order, so that an
     /// unordered `s` outside is returned too (onto the planes its labels name).
     pub fn return_map(&self, s: &[f64; 3]) -> Option<Return> {
-        // Nearly every return in compression: the shear plane at the first try.
-        match self.shear_first(s) {
-            FirstTry::Elastic => return None,
-            FirstTry::Shear(lambda, stress) => {
-                return Some(shear_return(lambda, stress, self.n_psi))
+        // Nearly every return in compression: the shear plane at the first try, which
+        // takes ordered values; others (a caller's, an edge's trial, NaN) are judged by
+        // `composite`, which takes any order, in the general search.
+        if s[0] <= s[1] && s[1] <= s[2] {
+            match self.shear_first(s, &self.shear_plane()) {
+                FirstTry::Elastic => return None,
+                FirstTry::Shear(lambda, stress) => {
+                    return Some(shear_return(lambda, stress, self.n_psi))
+                }
+                FirstTry::Other => {}
             }
-            FirstTry::Other => {}
         }
         let scale = s[0].abs().max(s[2].abs()).max(self.kc).max(self.st);
         if self.composite(s) <= 0.0 {
@@ -614,20 +640,18 @@ impl Surfaces {
         best.map(|(_, r)| r)
     }
 
-    /// The first try of [`Self::return_map`] for principal trial stresses `s` (ordered
-    /// in the update; the elastic check takes any order, as `composite` does):
+    /// The first try of [`Self::return_map`] for ordered principal trial stresses `s`
+    /// (σ1 ≤ σ2 ≤ σ3, as the decompositions give them; `return_map` checks the order),
+    /// with these surfaces' shear-plane constants `sp` ([`Self::shear_plane`]):
     /// not outside the surface, or the return onto the shear plane alone when that is
     /// the result (its multiplier and principal stresses), or neither (`Other`: the
     /// general search). The same operations on the same values as that search's first
     /// solve and checks (bit for bit), with no [`Return`] built, so that a run of
     /// elements ([`MohrCoulomb::update_many`]) can take it straight from the trial.
     #[inline(always)]
-    fn shear_first(&self, s: &[f64; 3]) -> FirstTry {
-        // The composite yield function, not outside: no return. Of the largest and the
-        // smallest value, not of s[2] and s[0]: a caller (or an edge's trial) may pass
-        // values out of order, and `composite` takes any order.
-        let (hi, lo) = (max2(max2(s[0], s[1]), s[2]), min2(min2(s[0], s[1]), s[2]));
-        if self.n_phi * hi - lo - self.kc <= 0.0 && hi - self.st <= 0.0 {
+    fn shear_first(&self, s: &[f64; 3], sp: &ShearPlane) -> FirstTry {
+        // The composite yield function of ordered values, not outside: no return.
+        if self.n_phi * s[2] - s[0] - self.kc <= 0.0 && s[2] - self.st <= 0.0 {
             return FirstTry::Elastic;
         }
         let h = self.h(s);
@@ -635,8 +659,7 @@ impl Surfaces {
             return FirstTry::Other;
         }
         // `solve_n` on the shear plane: the 1×1 system, its pivot test, λ ≥ 0.
-        let dg = self.elastic(&self.potential_gradient(0));
-        let a = dot(&self.yield_gradient(0), &dg);
+        let (dg, a) = (sp.dg, sp.a);
         let singular = a.abs() <= 1e-12 * 0.0f64.max(a.abs());
         let lambda = self.plane(0, s) / a;
         if singular || lambda < 0.0 {
@@ -841,6 +864,119 @@ impl MohrCoulomb {
             record(&r, st);
         }
     }
+
+    /// [`ConstitutiveModel::update_many`] with (`SOFT`) or without softening.
+    fn update_run<const SOFT: bool>(
+        &self,
+        inputs: &[ModelInput<'_>],
+        stresses: &mut [Sym6],
+        states: &mut [f64],
+        stride: usize,
+    ) {
+        const BLOCK: usize = 2 * LANES;
+        let stride = stride.max(1);
+        // As the default: elements beyond the shortest of the three are left alone.
+        let n = inputs.len().min(stresses.len()).min(states.len() / stride);
+        let (inputs, stresses) = (&inputs[..n], &mut stresses[..n]);
+        let blocks = inputs
+            .chunks(BLOCK)
+            .zip(stresses.chunks_mut(BLOCK))
+            .zip(states.chunks_mut(BLOCK * stride));
+        for ((inputs, stresses), states) in blocks {
+            // The elastic trials first, with the surfaces of each element's plastic
+            // strains (looked up only with softening); those not surely elastic are
+            // candidates.
+            let mut surfaces = [Surfaces::default(); BLOCK];
+            let (mut cand, mut nc) = ([0usize; BLOCK], 0);
+            for (i, (x, s)) in inputs.iter().zip(stresses.iter_mut()).enumerate() {
+                let st = &mut states[i * stride..(i + 1) * stride];
+                let yields = if SOFT {
+                    let f = self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
+                    surfaces[i] = f;
+                    self.trial_with(&f, x.dstrain, s, st)
+                } else {
+                    self.trial_with(&self.surfaces, x.dstrain, s, st)
+                };
+                cand[nc] = i;
+                nc += usize::from(yields);
+            }
+            let f_of = |i: usize| if SOFT { &surfaces[i] } else { &self.surfaces };
+            // The shear plane's constants once for the run when the surfaces are the
+            // model's, else per element.
+            let sp_model = self.surfaces.shear_plane();
+            let sp_of = |f: &Surfaces| if SOFT { f.shear_plane() } else { sp_model };
+            // Then the candidates: plane ones straight onto the shear plane where that is
+            // the return (histories written after the run, so that the square roots
+            // there overlap); the others wait for the general return, plane ones (closed
+            // form) and 3D ones (Jacobi) apart.
+            let (mut plane_wait, mut wait) = ([0usize; BLOCK], [0usize; BLOCK]);
+            let (mut np, mut n) = (0, 0);
+            let (mut shear, mut ns) = ([(0usize, 0.0f64, 0.0f64); BLOCK], 0);
+            for &i in &cand[..nc] {
+                let s = &mut stresses[i];
+                if !is_plane(s) {
+                    wait[n] = i;
+                    n += 1;
+                    continue;
+                }
+                let (f, p) = (f_of(i), plane(s));
+                match f.shear_first(&p.values, &sp_of(f)) {
+                    FirstTry::Elastic => continue,
+                    FirstTry::Shear(lambda, o) => {
+                        *s = compose_plane(&o, &p);
+                        shear[ns] = (i, lambda, f.n_psi);
+                        ns += 1;
+                        continue;
+                    }
+                    FirstTry::Other => {}
+                }
+                plane_wait[np] = i;
+                np += 1;
+            }
+            for &i in &plane_wait[..np] {
+                let st = &mut states[i * stride..];
+                self.plastic_plane(f_of(i), &mut stresses[i], st);
+            }
+            // The 3D ones: their decompositions, [`LANES`] at a time where there are
+            // enough, then with constant surfaces the shear plane at once if it is the
+            // return, else the general return.
+            for group in wait[..n].chunks(LANES) {
+                let ps: [Principal; LANES] = if group.len() <= 2 {
+                    let none = Principal {
+                        values: [0.0; 3],
+                        axes: [[0.0; 3]; 3],
+                    };
+                    std::array::from_fn(|l| group.get(l).map_or(none, |&i| principal(&stresses[i])))
+                } else {
+                    // Unused lanes get a zero tensor, which needs no rotation.
+                    let ts =
+                        std::array::from_fn(|l| group.get(l).map_or([0.0; 6], |&i| stresses[i]));
+                    principal_lanes(&ts)
+                };
+                for (&i, p) in group.iter().zip(&ps) {
+                    let f = f_of(i);
+                    match f.shear_first(&p.values, &sp_of(f)) {
+                        FirstTry::Elastic => {}
+                        FirstTry::Shear(lambda, o) => {
+                            stresses[i] = compose(&o, &p.axes);
+                            shear[ns] = (i, lambda, f.n_psi);
+                            ns += 1;
+                        }
+                        FirstTry::Other => {
+                            let st = &mut states[i * stride..];
+                            self.plastic(f, p, &mut stresses[i], st);
+                        }
+                    }
+                }
+            }
+            for &(i, lambda, n_psi) in &shear[..ns] {
+                record(
+                    &shear_return(lambda, [0.0; 3], n_psi),
+                    &mut states[i * stride..],
+                );
+            }
+        }
+    }
 }
 
 /// The [`Return`] of a return onto the shear plane alone with multiplier `lambda` to
@@ -914,111 +1050,13 @@ impl ConstitutiveModel for MohrCoulomb {
         states: &mut [f64],
         stride: usize,
     ) {
-        const BLOCK: usize = 2 * LANES;
-        let stride = stride.max(1);
-        // As the default: elements beyond the shortest of the three are left alone.
-        let n = inputs.len().min(stresses.len()).min(states.len() / stride);
-        let (inputs, stresses) = (&inputs[..n], &mut stresses[..n]);
-        let blocks = inputs
-            .chunks(BLOCK)
-            .zip(stresses.chunks_mut(BLOCK))
-            .zip(states.chunks_mut(BLOCK * stride));
-        for ((inputs, stresses), states) in blocks {
-            // The elastic trials first, with the surfaces of each element's plastic
-            // strains (looked up only with softening); those not surely elastic are
-            // candidates.
-            let mut surfaces = [Surfaces::default(); BLOCK];
-            let (mut cand, mut nc) = ([0usize; BLOCK], 0);
-            for (i, (x, s)) in inputs.iter().zip(stresses.iter_mut()).enumerate() {
-                let st = &mut states[i * stride..(i + 1) * stride];
-                let yields = match self.softening {
-                    None => self.trial_with(&self.surfaces, x.dstrain, s, st),
-                    Some(_) => {
-                        let f =
-                            self.surfaces_at(st[state::SHEAR_STRAIN], st[state::TENSION_STRAIN]);
-                        surfaces[i] = f;
-                        self.trial_with(&f, x.dstrain, s, st)
-                    }
-                };
-                cand[nc] = i;
-                nc += usize::from(yields);
-            }
-            let f_of = |i: usize| match self.softening {
-                None => &self.surfaces,
-                Some(_) => &surfaces[i],
-            };
-            // Then the candidates: plane ones straight onto the shear plane where that is
-            // the return (histories written after the run, so that the square roots
-            // there overlap); the others wait for the general return, plane ones (closed
-            // form) and 3D ones (Jacobi) apart.
-            let (mut plane_wait, mut wait) = ([0usize; BLOCK], [0usize; BLOCK]);
-            let (mut np, mut n) = (0, 0);
-            let (mut shear, mut ns) = ([(0usize, 0.0f64, 0.0f64); BLOCK], 0);
-            for &i in &cand[..nc] {
-                let s = &mut stresses[i];
-                if !is_plane(s) {
-                    wait[n] = i;
-                    n += 1;
-                    continue;
-                }
-                let (f, p) = (f_of(i), plane(s));
-                match f.shear_first(&p.values) {
-                    FirstTry::Elastic => continue,
-                    FirstTry::Shear(lambda, o) => {
-                        *s = compose_plane(&o, &p);
-                        shear[ns] = (i, lambda, f.n_psi);
-                        ns += 1;
-                        continue;
-                    }
-                    FirstTry::Other => {}
-                }
-                plane_wait[np] = i;
-                np += 1;
-            }
-            for &i in &plane_wait[..np] {
-                let st = &mut states[i * stride..];
-                self.plastic_plane(f_of(i), &mut stresses[i], st);
-            }
-            // The 3D ones: their decompositions, [`LANES`] at a time where there are
-            // enough, then with constant surfaces the shear plane at once if it is the
-            // return, else the general return.
-            for group in wait[..n].chunks(LANES) {
-                let ps: [Principal; LANES] = if group.len() <= 2 {
-                    let none = Principal {
-                        values: [0.0; 3],
-                        axes: [[0.0; 3]; 3],
-                    };
-                    std::array::from_fn(|l| group.get(l).map_or(none, |&i| principal(&stresses[i])))
-                } else {
-                    // Unused lanes get a zero tensor, which needs no rotation.
-                    let ts =
-                        std::array::from_fn(|l| group.get(l).map_or([0.0; 6], |&i| stresses[i]));
-                    principal_lanes(&ts)
-                };
-                for (&i, p) in group.iter().zip(&ps) {
-                    let f = f_of(i);
-                    match f.shear_first(&p.values) {
-                        FirstTry::Elastic => {}
-                        FirstTry::Shear(lambda, o) => {
-                            stresses[i] = compose(&o, &p.axes);
-                            shear[ns] = (i, lambda, f.n_psi);
-                            ns += 1;
-                        }
-                        FirstTry::Other => {
-                            let st = &mut states[i * stride..];
-                            self.plastic(f, p, &mut stresses[i], st);
-                        }
-                    }
-                }
-            }
-            for &(i, lambda, n_psi) in &shear[..ns] {
-                record(
-                    &shear_return(lambda, [0.0; 3], n_psi),
-                    &mut states[i * stride..],
-                );
-            }
+        // One build per case, so that without softening nothing of it is in the loops.
+        match self.softening {
+            None => self.update_run::<false>(inputs, stresses, states, stride),
+            Some(_) => self.update_run::<true>(inputs, stresses, states, stride),
         }
     }
+
     fn wgsl(&self) -> Option<WgslModel> {
         let f = &self.surfaces;
         let mut params = vec![
