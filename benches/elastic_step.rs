@@ -17,11 +17,12 @@
 //! initial state per iteration: the state restored from a snapshot and the first step
 //! run before it (both untimed), so that nearly every element returns to the surface in
 //! every timed step (the share is printed when the row starts: 99.6 % of the triangles
-//! and 81.9 % of the tetrahedra, 2026-12-08; all of them in the first step): run on, the block settles onto the surface and after ~100 steps only
-//! about 30 % of its triangles still yield in a step (measured, 2026-12-07). Not the
-//! first step: the restore is serial and long (~20 ms), and on a VM a step right after
-//! it found the other cores' vCPUs parked (two threads ran at one thread's speed: a
-//! step after `sleep(20 ms)` did too, with no restore at all, docs/performance.md).
+//! and 81.9 % of the tetrahedra, 2026-12-08; all of them in the first step). Run on,
+//! the block settles onto the surface and after ~100 steps only about 30 % of its
+//! triangles still yield in a step (measured, 2026-12-07). Not the first step: the
+//! restore is serial and long (~20 ms), and on a VM a step right after it found the
+//! other cores' vCPUs parked (two threads ran at one thread's speed: a step after
+//! `sleep(20 ms)` did too, with no restore at all, docs/performance.md).
 //!
 //! Quad4/Hex8 rows (`quad4_*`, `hex8_*`): the same blocks meshed with Quad4 cells
 //! (two triangles each, the triangles of the `tri3` row) and Hex8 cells (five or six

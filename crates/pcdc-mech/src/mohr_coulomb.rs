@@ -456,12 +456,11 @@ impl MohrCoulomb {
             // model's, else per element.
             let sp_model = self.surfaces.shear_plane();
             let sp_of = |f: &Surfaces| if SOFT { f.shear_plane() } else { sp_model };
-            // Then the candidates: plane ones straight onto the shear plane where that is
-            // the return (histories written after the run, so that the square roots
-            // there overlap); the others wait for the general return, plane ones (closed
-            // form) and 3D ones (Jacobi) apart.
-            let (mut plane_wait, mut wait) = ([0usize; BLOCK], [0usize; BLOCK]);
-            let (mut np, mut n) = (0, 0);
+            // Then the candidates: plane ones at once (closed form), straight onto the
+            // shear plane where that is the return (histories written after the run, so
+            // that the square roots there overlap), else the general search without a
+            // second first try; 3D ones wait for their decompositions in lanes.
+            let (mut wait, mut n) = ([0usize; BLOCK], 0);
             let (mut shear, mut ns) = ([(0usize, 0.0f64, 0.0f64); BLOCK], 0);
             for &i in &cand[..nc] {
                 let s = &mut stresses[i];
@@ -472,25 +471,23 @@ impl MohrCoulomb {
                 }
                 let (f, p) = (f_of(i), plane(s));
                 match f.shear_first(&p.values, &sp_of(f)) {
-                    FirstTry::Elastic => continue,
+                    FirstTry::Elastic => {}
                     FirstTry::Shear(lambda, o) => {
                         *s = compose_plane(&o, &p);
                         shear[ns] = (i, lambda, f.n_psi);
                         ns += 1;
-                        continue;
                     }
-                    FirstTry::Other => {}
+                    FirstTry::Other => {
+                        if let Some(r) = f.general_return(&p.values) {
+                            *s = compose_plane(&r.stress, &p);
+                            record(&r, &mut states[i * stride..]);
+                        }
+                    }
                 }
-                plane_wait[np] = i;
-                np += 1;
-            }
-            for &i in &plane_wait[..np] {
-                let st = &mut states[i * stride..];
-                self.plastic_plane(f_of(i), &mut stresses[i], st);
             }
             // The 3D ones: their decompositions, [`LANES`] at a time where there are
-            // enough, then with constant surfaces the shear plane at once if it is the
-            // return, else the general return.
+            // enough, then the shear plane at once if it is the return, else the general
+            // search.
             for group in wait[..n].chunks(LANES) {
                 let ps: [Principal; LANES] = if group.len() <= 2 {
                     let none = Principal {
@@ -514,8 +511,10 @@ impl MohrCoulomb {
                             ns += 1;
                         }
                         FirstTry::Other => {
-                            let st = &mut states[i * stride..];
-                            self.plastic(f, p, &mut stresses[i], st);
+                            if let Some(r) = f.general_return(&p.values) {
+                                stresses[i] = compose(&r.stress, &p.axes);
+                                record(&r, &mut states[i * stride..]);
+                            }
                         }
                     }
                 }

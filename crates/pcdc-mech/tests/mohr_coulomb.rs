@@ -473,8 +473,9 @@ fn vtu_step_shows_the_plastic_state() {
 }
 
 proptest! {
-    /// The run update (3D decompositions in lanes, plane ones apart, plane shear-plane
-    /// returns with constant surfaces straight from the trial) gives every element
+    /// The run update (3D decompositions in lanes, plane ones apart, returns that end on
+    /// the shear plane at the first try straight from the decomposition, the others'
+    /// search without a second first try) gives every element
     /// what the one-element update gives it, bit for bit: runs of any length, plane and
     /// 3D, elastic and yielding elements mixed, with softening (surfaces per element)
     /// and without, and a state stride wider than the model's.

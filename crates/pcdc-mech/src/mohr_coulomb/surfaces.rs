@@ -208,6 +208,13 @@ impl Surfaces {
                 FirstTry::Other => {}
             }
         }
+        self.general_return(s)
+    }
+
+    /// [`Self::return_map`] after its first try: the search over active sets, for a
+    /// caller whose own first try ([`Self::shear_first`]) found `Other`, so that it is
+    /// not made twice (the same result as `return_map`, bit for bit).
+    pub(super) fn general_return(&self, s: &[f64; 3]) -> Option<Return> {
         let scale = s[0].abs().max(s[2].abs()).max(self.kc).max(self.st);
         if self.composite(s) <= 0.0 {
             return None;
