@@ -63,7 +63,9 @@ use crate::principal::{
 };
 use crate::MechError;
 
+mod plane_lanes;
 mod surfaces;
+use plane_lanes::{shear_first_lanes, LaneSurfaces, PlaneLanes, BLOCK};
 use surfaces::{shear_return, FirstTry};
 pub use surfaces::{Return, Surfaces};
 
@@ -424,11 +426,18 @@ impl MohrCoulomb {
         states: &mut [f64],
         stride: usize,
     ) {
-        const BLOCK: usize = 2 * LANES;
+        // Fewer plane candidates than this go one at a time.
+        const PLANE_LANES_FROM: usize = 2;
         let stride = stride.max(1);
         // As the default: elements beyond the shortest of the three are left alone.
         let n = inputs.len().min(stresses.len()).min(states.len() / stride);
         let (inputs, stresses) = (&inputs[..n], &mut stresses[..n]);
+        let model_lanes = if SOFT {
+            LaneSurfaces::default()
+        } else {
+            LaneSurfaces::splat(&self.surfaces, &self.surfaces.shear_plane())
+        };
+        let mut lanes = PlaneLanes::default();
         let blocks = inputs
             .chunks(BLOCK)
             .zip(stresses.chunks_mut(BLOCK))
@@ -438,7 +447,10 @@ impl MohrCoulomb {
             // strains (looked up only with softening); those not surely elastic are
             // candidates.
             let mut surfaces = [Surfaces::default(); BLOCK];
-            let (mut cand, mut nc) = ([0usize; BLOCK], 0);
+            // Each element's class first (0 elastic, 1 plane candidate, 2 other
+            // candidate), then the lists: a list's length carried from element to element
+            // would make each trial wait for the one before.
+            let mut class = [0u8; BLOCK];
             for (i, (x, s)) in inputs.iter().zip(stresses.iter_mut()).enumerate() {
                 let st = &mut states[i * stride..(i + 1) * stride];
                 let yields = if SOFT {
@@ -448,40 +460,72 @@ impl MohrCoulomb {
                 } else {
                     self.trial_with(&self.surfaces, x.dstrain, s, st)
                 };
-                cand[nc] = i;
-                nc += usize::from(yields);
+                class[i] = u8::from(yields) * (2 - u8::from(is_plane(s)));
             }
             let f_of = |i: usize| if SOFT { &surfaces[i] } else { &self.surfaces };
             // The shear plane's constants once for the run when the surfaces are the
             // model's, else per element.
             let sp_model = self.surfaces.shear_plane();
             let sp_of = |f: &Surfaces| if SOFT { f.shear_plane() } else { sp_model };
-            // Then the candidates: plane ones at once (closed form), straight onto the
-            // shear plane where that is the return (histories written after the run, so
-            // that the square roots there overlap), else the general search without a
-            // second first try; 3D ones wait for their decompositions in lanes.
+            // Then the candidates: plane ones [`LANES`] at a time where there are enough
+            // (closed form, straight onto the shear plane where that is the return,
+            // `plane_lanes`), else one at a time; 3D ones wait for their decompositions
+            // in lanes. A candidate whose first try is not the shear plane takes the
+            // general search without a second first try; the histories of shear-plane
+            // returns are written after the run, so that the square roots there overlap.
+            let (mut flat, mut nf) = ([0usize; BLOCK], 0);
             let (mut wait, mut n) = ([0usize; BLOCK], 0);
+            for (i, &c) in class[..inputs.len()].iter().enumerate() {
+                flat[nf] = i;
+                nf += usize::from(c == 1);
+                wait[n] = i;
+                n += usize::from(c == 2);
+            }
             let (mut shear, mut ns) = ([(0usize, 0.0f64, 0.0f64); BLOCK], 0);
-            for &i in &cand[..nc] {
-                let s = &mut stresses[i];
-                if !is_plane(s) {
-                    wait[n] = i;
-                    n += 1;
+            let general = |i: usize, stress: &mut Sym6, states: &mut [f64]| {
+                let (f, p) = (f_of(i), plane(stress));
+                if let Some(r) = f.general_return(&p.values) {
+                    *stress = compose_plane(&r.stress, &p);
+                    record(&r, &mut states[i * stride..]);
+                }
+            };
+            for group in flat[..nf].chunks(LANES) {
+                if group.len() < PLANE_LANES_FROM {
+                    for &i in group {
+                        let (f, p) = (f_of(i), plane(&stresses[i]));
+                        match f.shear_first(&p.values, &sp_of(f)) {
+                            FirstTry::Elastic => {}
+                            FirstTry::Shear(lambda, o) => {
+                                stresses[i] = compose_plane(&o, &p);
+                                shear[ns] = (i, lambda, f.n_psi);
+                                ns += 1;
+                            }
+                            FirstTry::Other => general(i, &mut stresses[i], states),
+                        }
+                    }
                     continue;
                 }
-                let (f, p) = (f_of(i), plane(s));
-                match f.shear_first(&p.values, &sp_of(f)) {
-                    FirstTry::Elastic => {}
-                    FirstTry::Shear(lambda, o) => {
-                        *s = compose_plane(&o, &p);
-                        shear[ns] = (i, lambda, f.n_psi);
-                        ns += 1;
+                if SOFT {
+                    let mut ls = LaneSurfaces::default();
+                    for (l, &i) in group.iter().enumerate() {
+                        ls.set(l, &surfaces[i], &surfaces[i].shear_plane());
                     }
-                    FirstTry::Other => {
-                        if let Some(r) = f.general_return(&p.values) {
-                            *s = compose_plane(&r.stress, &p);
-                            record(&r, &mut states[i * stride..]);
+                    shear_first_lanes(stresses, group, &ls, &mut lanes);
+                } else {
+                    shear_first_lanes(stresses, group, &model_lanes, &mut lanes);
+                }
+                for (l, &i) in group.iter().enumerate() {
+                    let kind = lanes.kind[l];
+                    if kind == plane_lanes::SHEAR {
+                        stresses[i] = lanes.stress(l);
+                        if lanes.yielded[l] > 0.0 {
+                            let st = &mut states[i * stride..];
+                            st[state::SHEAR_NOW] = 1.0;
+                            st[state::SHEAR_PAST] = 1.0;
+                            st[state::SHEAR_STRAIN] += lanes.dkappa[l];
                         }
+                    } else if kind == plane_lanes::OTHER {
+                        general(i, &mut stresses[i], states);
                     }
                 }
             }
@@ -577,7 +621,8 @@ impl ConstitutiveModel for MohrCoulomb {
     /// ends on the shear plane at the first try is taken straight from the
     /// decomposition (`Surfaces::shear_first`, the first step of
     /// [`Surfaces::return_map`]), and the histories of those returns are written after
-    /// the run.
+    /// the run. Plane (2D) trials take that first try [`LANES`] at a time in one
+    /// branch-free kernel (`plane_lanes`), decomposition and recomposition included.
     fn update_many(
         &self,
         inputs: &[ModelInput<'_>],

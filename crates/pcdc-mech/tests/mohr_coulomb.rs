@@ -533,3 +533,107 @@ fn update_many_leaves_elements_beyond_the_shortest_slice_alone() {
     assert_eq!(stresses[2], [0.0; 6]);
     assert_eq!(states[2 * MC_STATE], 0.0);
 }
+
+/// Plane trials in every class a run meets side by side (the run update takes them
+/// [`pcdc_mech::principal::LANES`] at a time): surely elastic, inside but near the
+/// surface, onto the shear plane with σzz below, between and above the in-plane values,
+/// onto an edge, into tension and the apex (the general search), equal in-plane values
+/// (no in-plane direction) and a NaN; whatever the class of its neighbours, each element
+/// gets what the one-element update gives it, bit for bit, with and without softening,
+/// in runs of every length up to 40 (so lane groups of 1 to 8, full and partial).
+#[test]
+fn plane_runs_of_every_class_match_the_one_element_update() {
+    let turned = |p: [f64; 3], deg: f64| -> Sym6 {
+        let (c, s) = (deg.to_radians().cos(), deg.to_radians().sin());
+        // In-plane values p[0], p[1] on axes turned by `deg`, σzz = p[2].
+        [
+            p[0] * c * c + p[1] * s * s,
+            p[0] * s * s + p[1] * c * c,
+            p[2],
+            (p[0] - p[1]) * c * s,
+            0.0,
+            0.0,
+        ]
+    };
+    let trials: Vec<(Sym6, Sym6)> = vec![
+        (turned([-1e6, -2e6, -1.5e6], 10.0), [0.0; 6]),
+        (turned([-5e6, -14e6, -6e6], 20.0), [0.0; 6]),
+        (turned([-8e6, -40e6, -10e6], 30.0), [0.0; 6]),
+        (turned([-8e6, -40e6, -30e6], 40.0), [0.0; 6]),
+        (turned([-8e6, -40e6, -50e6], 50.0), [0.0; 6]),
+        (turned([-8e6, -40e6, -40e6], 60.0), [0.0; 6]),
+        (turned([-40e6, -40e6, -8e6], 0.0), [0.0; 6]),
+        (turned([3e6, -1e6, -2e6], 70.0), [0.0; 6]),
+        (turned([3e6, 3e6, 3e6], 80.0), [0.0; 6]),
+        (
+            turned([-9e6, -9e6, -9e6], 0.0),
+            [-1e-3, -1e-3, 0.0, 0.0, 0.0, 0.0],
+        ),
+        (
+            turned([-8e6, -30e6, -10e6], 15.0),
+            [-4e-4, 1e-4, 0.0, 2e-4, 0.0, 0.0],
+        ),
+        (
+            turned([-8e6, -30e6, -10e6], 25.0),
+            [f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
+    ];
+    for soft in [false, true] {
+        let m = if soft {
+            softening_model()
+        } else {
+            model(4e6, 35.0, 10.0, 2e6)
+        };
+        for n in 1..=40 {
+            // Element i takes trial (i * 7 + n) mod the trial count: every class beside
+            // every other as n changes.
+            let pick: Vec<_> = (0..n).map(|i| trials[(i * 7 + n) % trials.len()]).collect();
+            let (mut s1, mut s2): (Vec<Sym6>, Vec<Sym6>) = (
+                pick.iter().map(|t| t.0).collect(),
+                pick.iter().map(|t| t.0).collect(),
+            );
+            let kappa = |i: usize| if soft { 2e-4 * (i % 5) as f64 } else { 0.0 };
+            let mut st1 = vec![0.0; n * MC_STATE];
+            for i in 0..n {
+                st1[i * MC_STATE + state::SHEAR_STRAIN] = kappa(i);
+            }
+            let mut st2 = st1.clone();
+            for (i, (_, de)) in pick.iter().enumerate() {
+                m.update(
+                    de,
+                    de,
+                    &mut s1[i],
+                    &mut st1[i * MC_STATE..(i + 1) * MC_STATE],
+                );
+            }
+            let inputs: Vec<_> = pick
+                .iter()
+                .map(|(_, de)| ModelInput::new(de, de, &[]))
+                .collect();
+            m.update_many(&inputs, &mut s2, &mut st2, MC_STATE);
+            for i in 0..n {
+                assert_eq!(
+                    s1[i].map(f64::to_bits),
+                    s2[i].map(f64::to_bits),
+                    "soft {soft}, run of {n}, element {i}"
+                );
+            }
+            assert_eq!(
+                st1.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                st2.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                "soft {soft}, run of {n}"
+            );
+            if n == 40 {
+                // The run met the classes it is meant to: untouched, shear alone,
+                // tension.
+                let flags: Vec<_> = st1
+                    .chunks(MC_STATE)
+                    .map(|s| (s[state::SHEAR_NOW], s[state::TENSION_NOW]))
+                    .collect();
+                assert!(flags.contains(&(0.0, 0.0)), "soft {soft}: {flags:?}");
+                assert!(flags.contains(&(1.0, 0.0)), "soft {soft}: {flags:?}");
+                assert!(flags.iter().any(|f| f.1 == 1.0), "soft {soft}: {flags:?}");
+            }
+        }
+    }
+}

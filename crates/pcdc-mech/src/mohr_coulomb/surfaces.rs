@@ -31,9 +31,9 @@ pub struct Surfaces {
 #[derive(Clone, Copy, Debug)]
 pub(super) struct ShearPlane {
     /// D∇g₀, the elastic image of the shear plane's flow direction (Pa).
-    dg: [f64; 3],
+    pub(super) dg: [f64; 3],
     /// ∇f₀·D∇g₀ (Pa).
-    a: f64,
+    pub(super) a: f64,
 }
 
 /// √3, for [`Surfaces::surely_elastic`].
