@@ -59,7 +59,8 @@ use pcdc_compute::Table;
 
 use crate::model::{add_hooke, ConstitutiveModel, LinearElastic, ModelInput, Sym6, WgslModel};
 use crate::principal::{
-    compose, compose_plane, plane, principal, principal_lanes, Principal, JACOBI_STOP, LANES,
+    compose, compose_plane, plane, principal, principal_lanes, PlanePrincipal, Principal,
+    JACOBI_STOP, LANES,
 };
 use crate::MechError;
 
@@ -445,11 +446,11 @@ impl MohrCoulomb {
         for ((inputs, stresses), states) in blocks {
             // The elastic trials first, with the surfaces of each element's plastic
             // strains (looked up only with softening); those not surely elastic are
-            // candidates.
+            // candidates. Each element's class (0 elastic, 1 plane candidate, 2 other
+            // candidate) is found first and the lists built after: a list's length
+            // carried from element to element would make each trial wait for the one
+            // before.
             let mut surfaces = [Surfaces::default(); BLOCK];
-            // Each element's class first (0 elastic, 1 plane candidate, 2 other
-            // candidate), then the lists: a list's length carried from element to element
-            // would make each trial wait for the one before.
             let mut class = [0u8; BLOCK];
             for (i, (x, s)) in inputs.iter().zip(stresses.iter_mut()).enumerate() {
                 let st = &mut states[i * stride..(i + 1) * stride];
@@ -472,7 +473,8 @@ impl MohrCoulomb {
             // `plane_lanes`), else one at a time; 3D ones wait for their decompositions
             // in lanes. A candidate whose first try is not the shear plane takes the
             // general search without a second first try; the histories of shear-plane
-            // returns are written after the run, so that the square roots there overlap.
+            // returns are written after the run, so that the square roots there overlap
+            // (the plane lanes compute their increments themselves).
             let (mut flat, mut nf) = ([0usize; BLOCK], 0);
             let (mut wait, mut n) = ([0usize; BLOCK], 0);
             for (i, &c) in class[..inputs.len()].iter().enumerate() {
@@ -482,10 +484,9 @@ impl MohrCoulomb {
                 n += usize::from(c == 2);
             }
             let (mut shear, mut ns) = ([(0usize, 0.0f64, 0.0f64); BLOCK], 0);
-            let general = |i: usize, stress: &mut Sym6, states: &mut [f64]| {
-                let (f, p) = (f_of(i), plane(stress));
-                if let Some(r) = f.general_return(&p.values) {
-                    *stress = compose_plane(&r.stress, &p);
+            let general = |i: usize, p: &PlanePrincipal, stress: &mut Sym6, states: &mut [f64]| {
+                if let Some(r) = f_of(i).general_return(&p.values) {
+                    *stress = compose_plane(&r.stress, p);
                     record(&r, &mut states[i * stride..]);
                 }
             };
@@ -500,7 +501,7 @@ impl MohrCoulomb {
                                 shear[ns] = (i, lambda, f.n_psi);
                                 ns += 1;
                             }
-                            FirstTry::Other => general(i, &mut stresses[i], states),
+                            FirstTry::Other => general(i, &p, &mut stresses[i], states),
                         }
                     }
                     continue;
@@ -525,7 +526,10 @@ impl MohrCoulomb {
                             st[state::SHEAR_STRAIN] += lanes.dkappa[l];
                         }
                     } else if kind == plane_lanes::OTHER {
-                        general(i, &mut stresses[i], states);
+                        // The lanes keep no decomposition: the same one again (rare:
+                        // edges, corners, tension).
+                        let p = plane(&stresses[i]);
+                        general(i, &p, &mut stresses[i], states);
                     }
                 }
             }
