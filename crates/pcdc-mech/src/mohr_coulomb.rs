@@ -427,16 +427,20 @@ impl MohrCoulomb {
         states: &mut [f64],
         stride: usize,
     ) {
-        // Fewer plane candidates than this go one at a time.
+        // Fewer plane candidates than this go one at a time (a lone one would carry seven
+        // idle lanes; the threshold is a choice, not tuned by measurement).
         const PLANE_LANES_FROM: usize = 2;
         let stride = stride.max(1);
         // As the default: elements beyond the shortest of the three are left alone.
         let n = inputs.len().min(stresses.len()).min(states.len() / stride);
         let (inputs, stresses) = (&inputs[..n], &mut stresses[..n]);
+        // The shear plane's constants once per call when the surfaces are the model's
+        // (with softening they are found per element).
+        let sp_model = self.surfaces.shear_plane();
         let model_lanes = if SOFT {
             LaneSurfaces::default()
         } else {
-            LaneSurfaces::splat(&self.surfaces, &self.surfaces.shear_plane())
+            LaneSurfaces::splat(&self.surfaces, &sp_model)
         };
         let mut lanes = PlaneLanes::default();
         let blocks = inputs
@@ -464,9 +468,6 @@ impl MohrCoulomb {
                 class[i] = u8::from(yields) * (2 - u8::from(is_plane(s)));
             }
             let f_of = |i: usize| if SOFT { &surfaces[i] } else { &self.surfaces };
-            // The shear plane's constants once for the run when the surfaces are the
-            // model's, else per element.
-            let sp_model = self.surfaces.shear_plane();
             let sp_of = |f: &Surfaces| if SOFT { f.shear_plane() } else { sp_model };
             // Then the candidates: plane ones [`LANES`] at a time where there are enough
             // (closed form, straight onto the shear plane where that is the return,

@@ -10,7 +10,7 @@
 //! (`update_many_is_the_one_element_update_bit_for_bit` and
 //! `plane_runs_of_every_class_match_the_one_element_update` check it).
 
-use super::surfaces::{ShearPlane, Surfaces};
+use super::surfaces::{max2, min2, ShearPlane, Surfaces};
 use crate::model::Sym6;
 use crate::principal::LANES;
 
@@ -117,26 +117,6 @@ unsafe fn shear_first_lanes_avx2(
     out: &mut PlaneLanes,
 ) {
     shear_first_lanes_any(stresses, group, f, out)
-}
-
-/// The larger of two numbers that are not NaN, as `surfaces::max2`.
-#[inline(always)]
-fn max2(a: f64, b: f64) -> f64 {
-    if a > b {
-        a
-    } else {
-        b
-    }
-}
-
-/// The smaller of two numbers that are not NaN, as `surfaces::min2`.
-#[inline(always)]
-fn min2(a: f64, b: f64) -> f64 {
-    if a < b {
-        a
-    } else {
-        b
-    }
 }
 
 /// The body of [`shear_first_lanes`], inlined into each instruction-set version.

@@ -406,7 +406,7 @@ impl Surfaces {
 /// The larger of two numbers that are not NaN (one instruction, where `f64::max` also
 /// handles NaN).
 #[inline(always)]
-fn max2(a: f64, b: f64) -> f64 {
+pub(super) fn max2(a: f64, b: f64) -> f64 {
     if a > b {
         a
     } else {
@@ -416,7 +416,7 @@ fn max2(a: f64, b: f64) -> f64 {
 
 /// The smaller of two numbers that are not NaN (see [`max2`]).
 #[inline(always)]
-fn min2(a: f64, b: f64) -> f64 {
+pub(super) fn min2(a: f64, b: f64) -> f64 {
     if a < b {
         a
     } else {
