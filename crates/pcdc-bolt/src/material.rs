@@ -346,10 +346,24 @@ impl AxialLaw {
         plastic: f64,
         broken: bool,
     ) -> (f64, f64, SegmentState) {
-        if broken || elongation / l0 >= self.failure_strain {
+        let fails = broken || elongation / l0 >= self.failure_strain;
+        self.settle(fails, elongation, self.ea / l0, plastic)
+    }
+
+    /// [`AxialLaw::update`] once the failure test is done (`fails`), with the stiffness
+    /// `k` = E_b A_b / L₀ (N/m) known: the walk keeps `k` per segment and skips the
+    /// failure test's division where the strain is clearly below the failure strain.
+    #[inline(always)]
+    pub(crate) fn settle(
+        &self,
+        fails: bool,
+        elongation: f64,
+        k: f64,
+        plastic: f64,
+    ) -> (f64, f64, SegmentState) {
+        if fails {
             return (0.0, plastic, SegmentState::Broken);
         }
-        let k = self.ea / l0;
         let trial = k * (elongation - plastic);
         if trial > self.tensile {
             (

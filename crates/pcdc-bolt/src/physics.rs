@@ -24,6 +24,11 @@ pub(crate) struct Segment {
     pub dx: [f64; 3],
     pub l0: f64,
     pub law: AxialLaw,
+    /// E_b A_b / L₀ (N/m), as [`AxialLaw::update`] computes it.
+    pub k: f64,
+    /// An elongation (m) below which the strain is surely below the failure strain
+    /// (`walk::fail_below`), so that the walk divides by L₀ only near failure.
+    pub fail_below: f64,
     /// Axial damping coefficient (N·s/m).
     pub damping: f64,
 }
@@ -264,11 +269,14 @@ impl Bolts {
             self.segment_offset.push(self.segments.len());
             let seg0 = self.segments.len() as u32;
             for s in 0..n - 1 {
+                let l0 = bolt.segment_length(s);
                 self.segments.push(Segment {
                     n: [node + s as u32, node + s as u32 + 1],
                     dx: std::array::from_fn(|k| pts[s + 1][k] - pts[s][k]),
-                    l0: bolt.segment_length(s),
+                    l0,
                     law: eff.axial,
+                    k: eff.axial.ea / l0,
+                    fail_below: walk::fail_below(eff.axial.failure_strain, l0),
                     damping: eff.damping,
                 });
             }

@@ -337,20 +337,37 @@ impl Walk<'_> {
             slots = rest;
             let (own, hosts) = bolt_slots.split_at_mut(span.nodes * d);
             hosts.fill(0.0);
-            let mut prev: Option<SegmentOut> = None;
-            for i in i0..i0 + span.nodes {
-                let n = &nodes[i];
-                let next = (n.next != NONE).then(|| {
-                    let s = n.next as usize - first_segment;
-                    segment(
-                        &segments[s],
-                        kin,
-                        &mut axial[s],
-                        &mut plastic[s],
-                        &mut state[s],
-                    )
-                });
-                let before = if n.prev != NONE { prev.as_ref() } else { None };
+            let end = i0 + span.nodes;
+            // One node ahead: the next node's segment, bar force and axis are found
+            // before this node's grout, which does not need them, so that their chain
+            // of roots and divisions runs while the grout's work waits on this node's
+            // axis (found one node earlier).
+            let mut next: Option<SegmentOut> = None;
+            let mut ahead = ([0.0; 3], [0.0; 3]);
+            for j in i0..=end {
+                let bar = ahead;
+                if j < end {
+                    let m = &nodes[j];
+                    let after = if m.next != NONE {
+                        let s = m.next as usize - first_segment;
+                        Some(segment(
+                            &segments[s],
+                            kin,
+                            &mut axial[s],
+                            &mut plastic[s],
+                            &mut state[s],
+                        ))
+                    } else {
+                        None
+                    };
+                    let before = if m.prev != NONE { next.as_ref() } else { None };
+                    ahead = bar_and_axis(before, after.as_ref());
+                    next = after;
+                }
+                if j == i0 {
+                    continue;
+                }
+                let i = j - 1;
                 let l = i - i0;
                 let out = NodeOut {
                     slot: &mut own[l * d..(l + 1) * d],
@@ -360,44 +377,27 @@ impl Walk<'_> {
                     host: &mut host[i],
                     active: &mut active[i],
                 };
-                self.node(n, before, next.as_ref(), kin, out, hosts);
-                prev = next;
+                self.node(&nodes[i], bar, kin, out, hosts);
             }
-            i0 += span.nodes;
+            i0 = end;
         }
     }
 
-    /// One bolt node: its bar forces (previous then next segment), re-location if it has
-    /// left its host, the grout against the host with the host's confinement, the
-    /// lateral grout and the face plate; writes its slot, its grout force, slip, grout
-    /// point and host, and adds the reaction to its host's nodes' slots among `hosts`
-    /// (the slots of its bolt's path nodes).
-    #[allow(clippy::too_many_arguments)]
+    /// One bolt node with its bar force `f` and axis `a` ([`bar_and_axis`]):
+    /// re-location if it has left its host, the grout against the host with the host's
+    /// confinement, the lateral grout and the face plate; writes its slot, its grout
+    /// force, slip, grout point and host, and adds the reaction to its host's nodes'
+    /// slots among `hosts` (the slots of its bolt's path nodes).
+    #[inline(always)]
     fn node<D: Dim>(
         &self,
         n: &BoltNode,
-        prev: Option<&SegmentOut>,
-        next: Option<&SegmentOut>,
+        (f, a): ([f64; 3], [f64; 3]),
         kin: &Kinematics<'_, D>,
         out: NodeOut<'_>,
         hosts: &mut [f64],
     ) {
         let d = D::D;
-        // Bar forces on the node: +f e as the start of the next segment, −f e as the
-        // end of the previous one (fixed order: previous, next).
-        let mut f = [0.0; 3];
-        if let Some((g, _)) = prev {
-            (0..3).for_each(|k| f[k] -= g[k]);
-        }
-        if let Some((g, _)) = next {
-            (0..3).for_each(|k| f[k] += g[k]);
-        }
-        // Axis at the node: mean of the adjacent segments' current directions.
-        let mut axis = [0.0; 3];
-        for (_, e) in [prev, next].into_iter().flatten() {
-            (0..3).for_each(|k| axis[k] += e[k]);
-        }
-        let (a, _) = unit(axis);
         // Against the host's material point where the node is grouted.
         let anchor = out.anchor;
         let active = out.active;
@@ -477,8 +477,47 @@ impl Walk<'_> {
     }
 }
 
+/// A bolt node's bar force and axis from the segments `prev` and `next` (the node's
+/// end of the one, its start of the other): the force +f e as the start of the next
+/// segment, −f e as the end of the previous one (fixed order: previous, next), and the
+/// axis, the mean of their current directions (normalised).
+#[inline(always)]
+fn bar_and_axis(prev: Option<&SegmentOut>, next: Option<&SegmentOut>) -> ([f64; 3], [f64; 3]) {
+    let mut f = [0.0; 3];
+    if let Some((g, _)) = prev {
+        (0..3).for_each(|k| f[k] -= g[k]);
+    }
+    if let Some((g, _)) = next {
+        (0..3).for_each(|k| f[k] += g[k]);
+    }
+    let mut axis = [0.0; 3];
+    for (_, e) in [prev, next].into_iter().flatten() {
+        (0..3).for_each(|k| axis[k] += e[k]);
+    }
+    (f, unit(axis).0)
+}
+
+/// An elongation (m) below which a segment of reference length `l0` (m) is surely short
+/// of the failure strain `failure`: `failure` × `l0` less a relative 1e-12, which covers
+/// the roundings of the product and of the strain's division; for a bolt that never
+/// breaks (`failure` infinite), `l0` × the largest f64, below which the strain's
+/// division cannot overflow to infinity.
+pub(crate) fn fail_below(failure: f64, l0: f64) -> f64 {
+    (failure * l0).min(l0 * f64::MAX) * (1.0 - 1e-12)
+}
+
+/// Whether a segment of reference length `l0` (m) breaks at `elongation` (m, eq. 142):
+/// its strain `elongation / l0` reaches `failure`. Below `below` (see
+/// `Segment::fail_below`) the answer is no without the division, which then runs only
+/// near failure; the answer is that of the division everywhere.
+#[inline(always)]
+pub(crate) fn reaches_failure(elongation: f64, l0: f64, below: f64, failure: f64) -> bool {
+    elongation >= below && elongation / l0 >= failure
+}
+
 /// One segment: the axial force in total form from its elongation (eq. 138-142) into
 /// `axial`, `plastic`, `state`, plus damping on the relative axial velocity (eq. 148).
+#[inline(always)]
 fn segment<D: Dim>(
     seg: &Segment,
     kin: &Kinematics<'_, D>,
@@ -489,7 +528,10 @@ fn segment<D: Dim>(
     let d = D::D;
     let (e, elongation) = segment_state(seg, kin);
     let broken = SegmentState::from_value(*state) == SegmentState::Broken;
-    let (f, up, st) = seg.law.update(elongation, seg.l0, *plastic, broken);
+    // AxialLaw::update with the segment's stiffness kept (the same values).
+    let fails =
+        broken || reaches_failure(elongation, seg.l0, seg.fail_below, seg.law.failure_strain);
+    let (f, up, st) = seg.law.settle(fails, elongation, seg.k, *plastic);
     *axial = f;
     *plastic = up;
     *state = st as i32 as f64;
@@ -626,5 +668,36 @@ impl<'a> Block<'a> {
             slots: slots_r,
         };
         (head, tail)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{fail_below, reaches_failure};
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The failure test without the division below `fail_below` answers as the
+        /// division does, at and around the threshold (ulps either side).
+        #[test]
+        fn the_failure_shortcut_answers_as_the_division(
+            l0 in 1e-4f64..1e3,
+            failure in 1e-6f64..10.0,
+            t in -1e-9f64..1e-9,
+            ulps in -4i64..=4,
+        ) {
+            let below = fail_below(failure, l0);
+            let edge = failure * l0 * (1.0 + t);
+            let e = f64::from_bits((edge.to_bits() as i64 + ulps) as u64);
+            for x in [e, edge, failure * l0, -e, 0.0, below, f64::INFINITY, f64::NAN] {
+                prop_assert_eq!(reaches_failure(x, l0, below, failure), x / l0 >= failure, "{}", x);
+            }
+            // A bolt that never breaks.
+            let inf = f64::INFINITY;
+            let below_inf = fail_below(inf, l0);
+            for x in [e, f64::MAX, inf] {
+                prop_assert_eq!(reaches_failure(x, l0, below_inf, inf), x / l0 >= inf);
+            }
+        }
     }
 }
