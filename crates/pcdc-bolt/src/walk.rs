@@ -308,11 +308,11 @@ struct NodeOut<'a> {
 }
 
 impl Walk<'_> {
-    /// Walks every bolt of `b` from head to toe: at each node, the segment starting
-    /// there (axial force, eq. 138-142, plus damping, eq. 148), then the node with the
-    /// segments before and after it, whose grout reaction is added to its host's slots
-    /// in node order. Each segment is computed once; every entry is written by one bolt
-    /// only (deterministic in any block split).
+    /// Walks every bolt of `b` from head to toe: each segment (axial force, eq. 138-142,
+    /// plus damping, eq. 148) with the bar force and axis of the node it starts at, one
+    /// node ahead of the grout; then each node with them, whose grout reaction is added
+    /// to its host's slots in node order. Each segment is computed once; every entry is
+    /// written by one bolt only (deterministic in any block split).
     fn block<D: Dim>(&self, b: Block<'_>, kin: &Kinematics<'_, D>) {
         let d = D::D;
         let alen = crate::anchor_len(d);
